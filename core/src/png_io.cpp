@@ -1,0 +1,104 @@
+#include "handtrack/core/png_io.hpp"
+
+#include <png.h>
+
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+namespace handtrack {
+namespace {
+
+[[noreturn]] void fail(const std::filesystem::path& path, const std::string& what) {
+  throw std::runtime_error(path.string() + ": " + what);
+}
+
+struct PngImage {
+  png_image image{};
+  PngImage() {
+    std::memset(&image, 0, sizeof image);
+    image.version = PNG_IMAGE_VERSION;
+  }
+  ~PngImage() { png_image_free(&image); }
+  PngImage(const PngImage&) = delete;
+  PngImage& operator=(const PngImage&) = delete;
+};
+
+// Opens `path`, checks it is grayscale without alpha, returns the header.
+void begin_gray_read(const std::filesystem::path& path, PngImage& png) {
+  if (!std::filesystem::exists(path)) fail(path, "no such file");
+  if (png_image_begin_read_from_file(&png.image, path.c_str()) == 0) {
+    fail(path, std::string("not a readable PNG (") + png.image.message + ")");
+  }
+  if ((png.image.format & PNG_FORMAT_FLAG_COLOR) != 0 || (png.image.format & PNG_FORMAT_FLAG_ALPHA) != 0) {
+    fail(path, "expected a single-channel grayscale PNG");
+  }
+}
+
+void write(const std::filesystem::path& path, int width, int height, png_uint_32 format, const void* pixels,
+           size_t size_bytes, size_t bytes_per_pixel) {
+  if (width <= 0 || height <= 0 || size_bytes != static_cast<size_t>(width) * height * bytes_per_pixel) {
+    fail(path, "image buffer does not match its size");
+  }
+  PngImage png;
+  png.image.width = static_cast<png_uint_32>(width);
+  png.image.height = static_cast<png_uint_32>(height);
+  png.image.format = format;
+  if (png_image_write_to_file(&png.image, path.c_str(), 0, pixels, 0, nullptr) == 0) {
+    fail(path, std::string("cannot write PNG (") + png.image.message + ")");
+  }
+}
+
+}  // namespace
+
+Gray16Image read_png_gray16(const std::filesystem::path& path) {
+  PngImage png;
+  begin_gray_read(path, png);
+  const bool sixteen = (png.image.format & PNG_FORMAT_FLAG_LINEAR) != 0;
+  Gray16Image out{static_cast<int>(png.image.width), static_cast<int>(png.image.height), 1, {}};
+  out.pixels.resize(static_cast<size_t>(png.image.width) * png.image.height);
+  if (sixteen) {
+    // A 16-bit file is read as PNG_FORMAT_LINEAR_Y: libpng treats 16-bit data as linear and
+    // hands the stored values back unchanged (checked against the raw file in tests).
+    png.image.format = PNG_FORMAT_LINEAR_Y;
+    if (png_image_finish_read(&png.image, nullptr, out.pixels.data(), 0, nullptr) == 0) {
+      fail(path, std::string("corrupt PNG data (") + png.image.message + ")");
+    }
+  } else {
+    std::vector<uint8_t> narrow(out.pixels.size());
+    png.image.format = PNG_FORMAT_GRAY;
+    if (png_image_finish_read(&png.image, nullptr, narrow.data(), 0, nullptr) == 0) {
+      fail(path, std::string("corrupt PNG data (") + png.image.message + ")");
+    }
+    for (size_t i = 0; i < narrow.size(); ++i) out.pixels[i] = narrow[i];
+  }
+  return out;
+}
+
+Gray8Image read_png_gray8(const std::filesystem::path& path) {
+  PngImage png;
+  begin_gray_read(path, png);
+  if ((png.image.format & PNG_FORMAT_FLAG_LINEAR) != 0) fail(path, "expected an 8-bit PNG, found 16-bit");
+  Gray8Image out{static_cast<int>(png.image.width), static_cast<int>(png.image.height), 1, {}};
+  out.pixels.resize(static_cast<size_t>(png.image.width) * png.image.height);
+  png.image.format = PNG_FORMAT_GRAY;
+  if (png_image_finish_read(&png.image, nullptr, out.pixels.data(), 0, nullptr) == 0) {
+    fail(path, std::string("corrupt PNG data (") + png.image.message + ")");
+  }
+  return out;
+}
+
+void write_png_gray16(const std::filesystem::path& path, const Gray16Image& image) {
+  write(path, image.width, image.height, PNG_FORMAT_LINEAR_Y, image.pixels.data(),
+        image.pixels.size() * sizeof(uint16_t), sizeof(uint16_t));
+}
+
+void write_png_gray8(const std::filesystem::path& path, const Gray8Image& image) {
+  write(path, image.width, image.height, PNG_FORMAT_GRAY, image.pixels.data(), image.pixels.size(), 1);
+}
+
+void write_png_rgb(const std::filesystem::path& path, const RgbImage& image) {
+  write(path, image.width, image.height, PNG_FORMAT_RGB, image.pixels.data(), image.pixels.size(), 3);
+}
+
+}  // namespace handtrack
