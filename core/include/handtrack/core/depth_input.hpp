@@ -1,0 +1,88 @@
+#pragma once
+// From a depth image to the image Gaussian mixture C_I (Sec. 3.1 and 4): median filter, the working
+// volume, segmentation of the hand (not the forearm, not the body behind it), and a quadtree whose
+// leaves become unit-weight 2D Gaussians.
+
+#include "handtrack/core/camera.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace handtrack {
+
+struct DepthInputConfig {
+  int median_radius_px = 1;             // 3x3 median "to remove flying pixels" (Sec. 4)
+  double near_mm = 150.0;               // working volume, Sec. 4: "between 150 mm and 600 mm"
+  double far_mm = 600.0;
+  double quadtree_threshold_mm = 20.0;  // epsilon_c, Sec. 3.1: split until max - min < 20 mm
+  int quadtree_root_px = 32;            // root cell side at 320 px image width (scales with width)
+  int quadtree_min_leaf_px = 2;         // smallest cell at 320 px width (scales with width)
+  double min_leaf_fill = 0.5;           // a leaf must be at least this full of hand pixels
+  double continuity_mm = 25.0;          // neighbouring pixels closer than this are one surface
+  double min_hand_area_mm2 = 1500.0;    // smaller blobs are noise, not a hand
+  double hand_length_mm = 190.0;        // wrist to middle fingertip, bounds the hand region
+};
+
+// What the tracker knows about where the hand was: lets segmentation keep the hand and cut the
+// forearm at the wrist.
+struct HandHint {
+  Eigen::Vector3d palm_centre_mm;  // camera frame
+  Eigen::Vector3d wrist_mm;
+  Eigen::Vector3d finger_axis;     // unit, wrist toward the fingers
+};
+
+// One leaf of the quadtree: G_q with mu = leaf centre (pixels), sigma = a / sqrt(2), unit weight,
+// and d_q = mean depth of the leaf's pixels (Sec. 3.1).
+struct ImageGaussian {
+  double u = 0.0;
+  double v = 0.0;
+  double sigma_px = 1.0;
+  double depth_mm = 0.0;
+  int label = 0;  // majority part label of the leaf's pixels (Sec. 4.3), 0 when unlabelled
+  int side_px = 1;
+};
+
+struct DepthInput {
+  CameraIntrinsics camera;
+  std::vector<float> filtered_mm;     // median-filtered depth, 0 outside the working volume
+  std::vector<uint8_t> hand_mask;     // 1 = pixel belongs to the segmented hand
+  std::vector<ImageGaussian> gaussians;
+  double self_similarity = 0.0;       // E(C_I, C_I), normalises E_sim (Sec. 4.1)
+  int hand_pixels = 0;
+  Eigen::Vector3d hand_centroid_mm = Eigen::Vector3d::Zero();  // mean 3D point of the hand pixels
+  Eigen::Vector3d palm_centre_mm = Eigen::Vector3d::Zero();    // estimated palm centre
+  Eigen::Vector3d finger_axis = Eigen::Vector3d(0, -1, 0);     // estimated wrist->fingers direction
+  [[nodiscard]] bool has_hand() const { return !gaussians.empty(); }
+};
+
+class DepthInputBuilder {
+ public:
+  explicit DepthInputBuilder(DepthInputConfig config = {});
+
+  // Builds C_I for one frame. `labels` (optional, same size as the image) gives per-pixel part
+  // labels from the forest. Storage is reused between calls.
+  const DepthInput& build(const DepthImage& depth, const std::optional<HandHint>& hint,
+                          const uint8_t* labels = nullptr);
+  [[nodiscard]] const DepthInput& last() const { return out_; }
+  [[nodiscard]] const DepthInputConfig& config() const { return config_; }
+
+ private:
+  void median_filter(const DepthImage& depth);
+  void segment(const std::optional<HandHint>& hint);
+  void build_quadtree(const uint8_t* labels);
+  void quad(int x, int y, int side, int min_leaf, const uint8_t* labels);
+
+  DepthInputConfig config_;
+  DepthInput out_;
+  std::vector<int> component_;
+  std::vector<int> stack_;
+  std::vector<float> window_;
+};
+
+// E(C_a, C_b) of paper eq. 3 for two sets of image-plane Gaussians.
+double image_self_similarity(const std::vector<ImageGaussian>& gaussians);
+
+}  // namespace handtrack

@@ -1,0 +1,105 @@
+#pragma once
+// Frame-to-frame hand tracking (Sec. 5): several pose particles per frame, each initialised by
+// extrapolating the two previous poses with random factors and optimised with the adaptive
+// gradient ascent; the particle with the best final energy wins. A tracker starts (and restarts
+// after the fit is clearly wrong) from an open hand placed at the segmented hand.
+//
+// Threading: a PoseTracker is used by one thread at a time. preprocess() and optimise() touch
+// disjoint state, so a pipeline may run preprocess() of frame t+1 while optimise() runs on frame t
+// as long as each has its own DepthInputBuilder (see HandHint).
+
+#include "handtrack/core/depth_input.hpp"
+#include "handtrack/core/energy.hpp"
+#include "handtrack/core/hand_model.hpp"
+#include "handtrack/core/optimizer.hpp"
+#include "handtrack/core/sequence.hpp"
+
+#include <cstdint>
+#include <optional>
+#include <random>
+
+namespace handtrack {
+
+enum class TrackingState : uint8_t { kNoHand = 0, kTracking = 1, kRecovering = 2 };
+const char* to_string(TrackingState state);
+
+struct TrackerConfig {
+  DepthInputConfig input;
+  EnergyWeights weights;
+  OptimizerConfig optimizer;
+  HandScale scale;
+  int particles = 2;                 // Sec. 7: "the best accuracy was with 2 particles"
+  // Sec. 5: P_i = Theta^{t-1} + alpha_ij (Theta^{t-1} - Theta^{t-2}), alpha_ij ~ N(mean, sigma).
+  double extrapolation_mean = 0.5;
+  double extrapolation_sigma = 0.5;
+  int init_iterations = 40;          // iterations for a (re)start from the open hand
+  double lost_confidence = 0.3;      // below this for `lost_frames` frames in a row: restart
+  int lost_frames = 3;
+  uint64_t seed = 1;
+};
+
+struct TrackerOutput {
+  TrackingState state = TrackingState::kNoHand;
+  PoseParams params = PoseParams::Zero();
+  Joints joints{};
+  std::array<Eigen::Vector3d, kNumFingers> fingertips{};
+  Eigen::Vector3d palm_centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d palm_normal = Eigen::Vector3d::Zero();  // out of the palm, camera frame
+  double energy = 0.0;
+  double confidence = 0.0;           // fraction of the hand's depth explained by the model, in [0, 1]
+  double pinch_distance_mm = 0.0;    // thumb tip to index tip, surface to surface
+  double pinch_strength = 0.0;       // 1 = touching, 0 = apart (>= 40 mm)
+  int winning_particle = -1;
+};
+
+class PoseTracker {
+ public:
+  explicit PoseTracker(TrackerConfig config = {});
+
+  // Where segmentation should look for the hand in the next frame (none before the first pose).
+  [[nodiscard]] std::optional<HandHint> hint() const;
+  // Optimises the pose for one frame's C_I and updates the history.
+  TrackerOutput optimise(const DepthInput& input);
+  // Forget the history: the next frame starts from the open hand.
+  void reset();
+
+  [[nodiscard]] const HandModel& model() const { return model_; }
+  [[nodiscard]] const TrackerConfig& config() const { return config_; }
+  void set_scale(const HandScale& scale);
+  // Open hand placed at the segmented hand of `input` (Sec. 5's start pose).
+  [[nodiscard]] PoseParams initial_pose(const DepthInput& input, double in_plane_offset_rad = 0.0) const;
+  // How much of the segmented hand the posed model explains, in [0, 1].
+  [[nodiscard]] double confidence(const DepthInput& input, const PosedHand& hand) const;
+
+ private:
+  TrackerOutput describe(const PoseParams& params, double energy, const DepthInput& input, TrackingState state);
+
+  TrackerConfig config_;
+  HandModel model_;
+  PoseEnergy energy_;
+  AdaptiveGradientAscent optimizer_;
+  PosedHand scratch_;
+  std::mt19937_64 rng_;
+  std::optional<PoseParams> previous_;
+  std::optional<PoseParams> before_previous_;
+  int low_confidence_run_ = 0;
+  bool recovering_ = false;
+};
+
+// preprocess + optimise on one thread: what handtrack-eval and the single-threaded path use.
+class Tracker {
+ public:
+  explicit Tracker(TrackerConfig config = {}) : builder_(config.input), pose_(config) {}
+  TrackerOutput track(const DepthImage& depth, const uint8_t* labels = nullptr) {
+    return pose_.optimise(builder_.build(depth, pose_.hint(), labels));
+  }
+  [[nodiscard]] const DepthInput& last_input() const { return builder_.last(); }
+  [[nodiscard]] PoseTracker& pose_tracker() { return pose_; }
+  void reset() { pose_.reset(); }
+
+ private:
+  DepthInputBuilder builder_;
+  PoseTracker pose_;
+};
+
+}  // namespace handtrack

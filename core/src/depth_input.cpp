@@ -1,0 +1,325 @@
+#include "handtrack/core/depth_input.hpp"
+
+#include "handtrack/core/hand_model.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace handtrack {
+namespace {
+
+using Eigen::Vector3d;
+
+// Radius around the palm centre that holds the whole hand, in hand lengths: an extended middle
+// fingertip is ~0.75 hand lengths from the palm centre; the margin allows for motion between frames.
+constexpr double kHandRadiusInLengths = 0.85;
+// The forearm is cut this far below the wrist joint (mm): the wrist's own surface stays in.
+constexpr double kWristCutMarginMm = 10.0;
+// Pixels this close to the image border mark the end of a blob where the arm leaves the image.
+constexpr int kBorderPx = 3;
+
+int scaled_px(int px_at_320, int width) { return std::max(1, px_at_320 * std::max(1, width / 320)); }
+
+}  // namespace
+
+DepthInputBuilder::DepthInputBuilder(DepthInputConfig config) : config_(config) {}
+
+const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::optional<HandHint>& hint,
+                                           const uint8_t* labels) {
+  out_.camera = depth.camera;
+  median_filter(depth);
+  segment(hint);
+  build_quadtree(labels);
+  out_.self_similarity = image_self_similarity(out_.gaussians);
+  return out_;
+}
+
+void DepthInputBuilder::median_filter(const DepthImage& depth) {
+  const int w = depth.width();
+  const int h = depth.height();
+  const int r = config_.median_radius_px;
+  out_.filtered_mm.assign(depth.depth_mm.size(), 0.0F);
+  const auto near = static_cast<float>(config_.near_mm);
+  const auto far = static_cast<float>(config_.far_mm);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      window_.clear();
+      for (int dv = -r; dv <= r; ++dv) {
+        for (int du = -r; du <= r; ++du) {
+          const int uu = std::clamp(u + du, 0, w - 1);
+          const int vv = std::clamp(v + dv, 0, h - 1);
+          const float d = depth.at(uu, vv);
+          window_.push_back(std::isfinite(d) ? d : 0.0F);
+        }
+      }
+      const auto mid = window_.begin() + static_cast<std::ptrdiff_t>(window_.size() / 2);
+      std::nth_element(window_.begin(), mid, window_.end());
+      const float m = *mid;
+      out_.filtered_mm[static_cast<size_t>(v) * w + u] = (m >= near && m <= far) ? m : 0.0F;
+    }
+  }
+}
+
+void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
+  const auto& cam = out_.camera;
+  const int w = cam.width;
+  const int h = cam.height;
+  const auto n = static_cast<size_t>(w) * h;
+  const auto& d = out_.filtered_mm;
+  out_.hand_mask.assign(n, 0);
+  out_.hand_pixels = 0;
+  const auto point = [&](size_t i) {
+    return cam.unproject(static_cast<double>(i % w), static_cast<double>(i / w), d[i]);
+  };
+  const double hand_radius = kHandRadiusInLengths * config_.hand_length_mm;
+
+  Vector3d centre;
+  Vector3d axis;
+  Vector3d wrist;
+  bool found = false;
+  if (hint) {
+    centre = hint->palm_centre_mm;
+    axis = hint->finger_axis;
+    wrist = hint->wrist_mm;
+    found = true;
+  }
+  // Keeps pixels near `centre` and above the wrist plane; returns how many.
+  const auto select = [&]() {
+    int count = 0;
+    for (size_t i = 0; i < n; ++i) {
+      out_.hand_mask[i] = 0;
+      if (d[i] <= 0.0F) continue;
+      const Vector3d p = point(i);
+      if ((p - centre).squaredNorm() > hand_radius * hand_radius) continue;
+      if ((p - wrist).dot(axis) < -kWristCutMarginMm) continue;
+      out_.hand_mask[i] = 1;
+      ++count;
+    }
+    return count;
+  };
+  const auto area_mm2 = [&](int pixels, double depth_mm) { return pixels * depth_mm * depth_mm / (cam.fx * cam.fy); };
+
+  int count = found ? select() : 0;
+  if (found && area_mm2(count, centre.z()) < config_.min_hand_area_mm2) found = false;
+
+  if (!found) {
+    // No usable hint: the nearest sizeable surface in the working volume is the hand (and maybe
+    // its forearm). Label 4-connected surfaces whose neighbouring depths differ < continuity_mm.
+    component_.assign(n, -1);
+    struct Blob {
+      int pixels = 0;
+      double depth_sum = 0.0;
+    };
+    std::vector<Blob> blobs;
+    for (size_t seed = 0; seed < n; ++seed) {
+      if (d[seed] <= 0.0F || component_[seed] >= 0) continue;
+      const int id = static_cast<int>(blobs.size());
+      Blob blob;
+      stack_.clear();
+      stack_.push_back(static_cast<int>(seed));
+      component_[seed] = id;
+      while (!stack_.empty()) {
+        const auto i = static_cast<size_t>(stack_.back());
+        stack_.pop_back();
+        ++blob.pixels;
+        blob.depth_sum += d[i];
+        const int u = static_cast<int>(i % w);
+        const int v = static_cast<int>(i / w);
+        const auto visit = [&](int uu, int vv) {
+          if (uu < 0 || vv < 0 || uu >= w || vv >= h) return;
+          const auto j = static_cast<size_t>(vv) * w + uu;
+          if (component_[j] >= 0 || d[j] <= 0.0F || std::abs(d[j] - d[i]) >= config_.continuity_mm) return;
+          component_[j] = id;
+          stack_.push_back(static_cast<int>(j));
+        };
+        visit(u - 1, v);
+        visit(u + 1, v);
+        visit(u, v - 1);
+        visit(u, v + 1);
+      }
+      blobs.push_back(blob);
+    }
+    int best = -1;
+    double best_depth = std::numeric_limits<double>::infinity();
+    for (size_t b = 0; b < blobs.size(); ++b) {
+      const double mean = blobs[b].depth_sum / blobs[b].pixels;
+      if (area_mm2(blobs[b].pixels, mean) < config_.min_hand_area_mm2) continue;
+      if (mean < best_depth) {
+        best_depth = mean;
+        best = static_cast<int>(b);
+      }
+    }
+    if (best < 0) {
+      std::fill(out_.hand_mask.begin(), out_.hand_mask.end(), 0);
+      out_.gaussians.clear();
+      return;
+    }
+    // Principal axis of the blob; the hand is the end that does not leave the image (the arm
+    // does), or, when neither or both do, the end nearer the camera.
+    Vector3d mean = Vector3d::Zero();
+    int pixels = 0;
+    for (size_t i = 0; i < n; ++i) {
+      if (component_[i] != best) continue;
+      mean += point(i);
+      ++pixels;
+    }
+    mean /= pixels;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (size_t i = 0; i < n; ++i) {
+      if (component_[i] != best) continue;
+      const Vector3d q = point(i) - mean;
+      cov += q * q.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    axis = eig.eigenvectors().col(2);
+    double lo = std::numeric_limits<double>::infinity();
+    double hi = -lo;
+    for (size_t i = 0; i < n; ++i) {
+      if (component_[i] != best) continue;
+      const double s = (point(i) - mean).dot(axis);
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    constexpr double kEndMm = 40.0;
+    struct End {
+      int border = 0;
+      int pixels = 0;
+      double depth = 0.0;
+    } top, bottom;
+    for (size_t i = 0; i < n; ++i) {
+      if (component_[i] != best) continue;
+      const double s = (point(i) - mean).dot(axis);
+      End* end = s > hi - kEndMm ? &top : s < lo + kEndMm ? &bottom : nullptr;
+      if (end == nullptr) continue;
+      const int u = static_cast<int>(i % w);
+      const int v = static_cast<int>(i / w);
+      end->border += (u < kBorderPx || v < kBorderPx || u >= w - kBorderPx || v >= h - kBorderPx) ? 1 : 0;
+      end->depth += d[i];
+      ++end->pixels;
+    }
+    const bool top_is_hand = top.border != bottom.border ? top.border < bottom.border
+                                                         : top.depth / std::max(1, top.pixels) <=
+                                                               bottom.depth / std::max(1, bottom.pixels);
+    if (!top_is_hand) {
+      axis = -axis;
+      std::swap(lo, hi);
+      lo = -lo;
+      hi = -hi;
+    }
+    const double tip = hi;
+    const double length = config_.hand_length_mm;
+    // The palm centre lies ~0.6 hand lengths below the fingertips; a blob shorter than a hand is
+    // all hand (a fist, or no forearm in view).
+    centre = (hi - lo) > length ? mean + axis * (tip - 0.6 * length) : mean;
+    wrist = (hi - lo) > length ? mean + axis * (tip - length) : mean + axis * (lo - kWristCutMarginMm);
+    count = select();
+  }
+  out_.hand_pixels = count;
+  out_.finger_axis = axis;
+  out_.palm_centre_mm = centre;
+  Vector3d sum = Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    if (out_.hand_mask[i]) sum += point(i);
+  }
+  out_.hand_centroid_mm = count > 0 ? Vector3d(sum / count) : centre;
+  if (area_mm2(count, out_.hand_centroid_mm.z()) < config_.min_hand_area_mm2) {
+    std::fill(out_.hand_mask.begin(), out_.hand_mask.end(), 0);
+    out_.hand_pixels = 0;
+  }
+}
+
+void DepthInputBuilder::build_quadtree(const uint8_t* labels) {
+  out_.gaussians.clear();
+  if (out_.hand_pixels == 0) return;
+  const int w = out_.camera.width;
+  const int h = out_.camera.height;
+  const int root = scaled_px(config_.quadtree_root_px, w);
+  const int min_leaf = scaled_px(config_.quadtree_min_leaf_px, w);
+  // Only roots that touch the hand's bounding box.
+  int u0 = w;
+  int v0 = h;
+  int u1 = -1;
+  int v1 = -1;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      if (!out_.hand_mask[static_cast<size_t>(v) * w + u]) continue;
+      u0 = std::min(u0, u);
+      v0 = std::min(v0, v);
+      u1 = std::max(u1, u);
+      v1 = std::max(v1, v);
+    }
+  }
+  for (int y = (v0 / root) * root; y <= v1; y += root) {
+    for (int x = (u0 / root) * root; x <= u1; x += root) quad(x, y, root, min_leaf, labels);
+  }
+}
+
+void DepthInputBuilder::quad(int x, int y, int side, int min_leaf, const uint8_t* labels) {
+  const int w = out_.camera.width;
+  const int h = out_.camera.height;
+  const int xe = std::min(x + side, w);
+  const int ye = std::min(y + side, h);
+  int count = 0;
+  float lo = std::numeric_limits<float>::infinity();
+  float hi = 0.0F;
+  double sum = 0.0;
+  for (int v = y; v < ye; ++v) {
+    for (int u = x; u < xe; ++u) {
+      const auto i = static_cast<size_t>(v) * w + u;
+      if (!out_.hand_mask[i]) continue;
+      const float dd = out_.filtered_mm[i];
+      ++count;
+      sum += dd;
+      lo = std::min(lo, dd);
+      hi = std::max(hi, dd);
+    }
+  }
+  if (count == 0) return;
+  const int area = (xe - x) * (ye - y);
+  const bool full_enough = count >= config_.min_leaf_fill * area;
+  const bool flat = hi - lo < config_.quadtree_threshold_mm;
+  if (side > min_leaf && !(flat && full_enough)) {
+    const int half = side / 2;
+    quad(x, y, half, min_leaf, labels);
+    quad(x + half, y, half, min_leaf, labels);
+    quad(x, y + half, half, min_leaf, labels);
+    quad(x + half, y + half, half, min_leaf, labels);
+    return;
+  }
+  if (!full_enough) return;
+  ImageGaussian g;
+  g.u = x + 0.5 * side - 0.5;  // pixel centres are at integer coordinates
+  g.v = y + 0.5 * side - 0.5;
+  g.sigma_px = side / std::sqrt(2.0);  // Sec. 3.1: sigma = a / sqrt(2)
+  g.depth_mm = sum / count;
+  g.side_px = side;
+  if (labels != nullptr) {
+    std::array<int, kNumPartLabels + 1> votes{};
+    for (int v = y; v < ye; ++v) {
+      for (int u = x; u < xe; ++u) {
+        const auto i = static_cast<size_t>(v) * w + u;
+        if (out_.hand_mask[i] && labels[i] <= kNumPartLabels) ++votes[labels[i]];
+      }
+    }
+    g.label = static_cast<int>(std::max_element(votes.begin() + 1, votes.end()) - votes.begin());
+    if (votes[static_cast<size_t>(g.label)] == 0) g.label = 0;
+  }
+  out_.gaussians.push_back(g);
+}
+
+double image_self_similarity(const std::vector<ImageGaussian>& gaussians) {
+  double e = 0.0;
+  for (const auto& a : gaussians) {
+    for (const auto& b : gaussians) {
+      const double du = a.u - b.u;
+      const double dv = a.v - b.v;
+      e += overlap_2d(du * du + dv * dv, a.sigma_px, b.sigma_px);
+    }
+  }
+  return e;
+}
+
+}  // namespace handtrack

@@ -1,0 +1,205 @@
+#include "handtrack/core/tracker.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace handtrack {
+
+using Eigen::Vector3d;
+
+namespace {
+// In-plane rotations (rad) tried around the segmented hand's axis when (re)starting.
+constexpr std::array<double, 3> kStartRotations = {0.0, 0.4, -0.4};
+// Pinch strength falls from 1 (tips touching) to 0 at this surface distance.
+constexpr double kPinchOpenMm = 40.0;
+}  // namespace
+
+const char* to_string(TrackingState state) {
+  switch (state) {
+    case TrackingState::kNoHand: return "no_hand";
+    case TrackingState::kTracking: return "tracking";
+    case TrackingState::kRecovering: return "recovering";
+  }
+  return "?";
+}
+
+PoseTracker::PoseTracker(TrackerConfig config)
+    : config_(config),
+      model_(HandModel::default_adult(config.scale)),
+      energy_(SimilarityFactor::kDepth, config.weights),
+      optimizer_(config.optimizer),
+      rng_(config.seed) {}
+
+void PoseTracker::set_scale(const HandScale& scale) {
+  config_.scale = scale;
+  model_ = HandModel::default_adult(scale);
+}
+
+void PoseTracker::reset() {
+  previous_.reset();
+  before_previous_.reset();
+  low_confidence_run_ = 0;
+}
+
+std::optional<HandHint> PoseTracker::hint() const {
+  if (!previous_) return std::nullopt;
+  const PosedHand hand(model_, *previous_);
+  return HandHint{hand.to_camera(model_.palm_centre()), hand.camera_t_hand(),
+                  hand.camera_R_hand() * Vector3d::UnitY()};
+}
+
+PoseParams PoseTracker::initial_pose(const DepthInput& input, double in_plane_offset_rad) const {
+  // Frontal open hand (r = 0: fingers toward -y in the image) turned in the image plane onto the
+  // hand's axis: rotation phi about the camera z maps (0,-1) to (sin phi, -cos phi).
+  const Vector3d& axis = input.finger_axis;
+  const double phi = std::atan2(axis.x(), -axis.y()) + in_plane_offset_rad;
+  PoseParams params = PoseParams::Zero();
+  params.segment<3>(kRotationParam) = Vector3d(0, 0, phi);
+  const PosedHand at_origin(model_, params);
+  // The segmented palm centre is a surface point; the model's palm centre is half a palm inside.
+  const double palm_half_thickness = model_.gaussians().back().sigma_mm;
+  const Vector3d target = input.palm_centre_mm + Vector3d(0, 0, palm_half_thickness);
+  params.segment<3>(kTranslationParam) = target - at_origin.camera_R_hand() * model_.palm_centre();
+  return params;
+}
+
+double PoseTracker::confidence(const DepthInput& input, const PosedHand& hand) const {
+  if (input.gaussians.empty()) return 0.0;
+  const auto& cam = input.camera;
+  const auto& gaussians = model_.gaussians();
+  struct Projected {
+    double u, v, sigma, depth, reach;
+  };
+  std::array<Projected, 64> projected{};
+  const int m = std::min<int>(hand.gaussian_count(), static_cast<int>(projected.size()));
+  int bad = 0;
+  for (int p = 0; p < m; ++p) {
+    const Vector3d& mu = hand.centre(p);
+    const double sigma_h = gaussians[static_cast<size_t>(p)].sigma_mm;
+    if (mu.z() < 1.0) {
+      ++bad;
+      projected[static_cast<size_t>(p)] = {-1e9, -1e9, 0, 0, 0};
+      continue;
+    }
+    const Eigen::Vector2d uv = cam.project(mu);
+    projected[static_cast<size_t>(p)] = {uv.x(), uv.y(), sigma_h * cam.focal() / mu.z(), mu.z() - sigma_h,
+                                         2.0 * sigma_h + 10.0};
+    // A model Gaussian over no data or over background floats in empty space; one behind data
+    // nearer the camera is merely occluded.
+    const int u = static_cast<int>(std::lround(uv.x()));
+    const int v = static_cast<int>(std::lround(uv.y()));
+    if (u < 0 || v < 0 || u >= cam.width || v >= cam.height) {
+      ++bad;
+      continue;
+    }
+    const float d = input.filtered_mm[static_cast<size_t>(v) * cam.width + u];
+    const double surface = mu.z() - sigma_h;
+    if (d <= 0.0F || d > surface + 3.0 * sigma_h + 20.0) ++bad;
+  }
+  double covered = 0.0;
+  double total = 0.0;
+  for (const auto& q : input.gaussians) {
+    const double area = static_cast<double>(q.side_px) * q.side_px;
+    total += area;
+    for (int p = 0; p < m; ++p) {
+      const auto& pr = projected[static_cast<size_t>(p)];
+      const double du = pr.u - q.u;
+      const double dv = pr.v - q.v;
+      const double r = pr.sigma + 0.5 * q.side_px;
+      if (du * du + dv * dv < r * r && std::abs(pr.depth - q.depth_mm) < pr.reach) {
+        covered += area;
+        break;
+      }
+    }
+  }
+  const double coverage = total > 0.0 ? covered / total : 0.0;
+  return coverage * (1.0 - static_cast<double>(bad) / std::max(1, m));
+}
+
+TrackerOutput PoseTracker::optimise(const DepthInput& input) {
+  if (!input.has_hand()) {
+    reset();
+    recovering_ = true;
+    TrackerOutput none;
+    none.state = TrackingState::kNoHand;
+    return none;
+  }
+  EnergyFrame frame{&model_, &input, nullptr, nullptr};
+  // (Re)start: the open hand at the segmented hand, a few in-plane rotations, the best energy wins.
+  const auto start = [&]() {
+    OptimizerResult best{PoseParams::Zero(), -1e300};
+    for (double offset : kStartRotations) {
+      auto r = optimizer_.maximise(energy_, frame, initial_pose(input, offset), scratch_, config_.init_iterations);
+      if (r.energy > best.energy) best = r;
+    }
+    return best;
+  };
+
+  OptimizerResult best{PoseParams::Zero(), -1e300};
+  int winner = -1;
+  if (!previous_) {
+    best = start();
+    recovering_ = true;
+  } else {
+    frame.previous = &*previous_;
+    frame.before_previous = before_previous_ ? &*before_previous_ : nullptr;
+    const PoseParams velocity = before_previous_ ? PoseParams(*previous_ - *before_previous_) : PoseParams::Zero();
+    std::normal_distribution<double> alpha(config_.extrapolation_mean, config_.extrapolation_sigma);
+    for (int i = 0; i < config_.particles; ++i) {
+      PoseParams particle = *previous_;
+      for (int j = 0; j < kNumPoseParams; ++j) particle[j] += alpha(rng_) * velocity[j];
+      const auto r = optimizer_.maximise(energy_, frame, particle, scratch_);
+      if (r.energy > best.energy) {
+        best = r;
+        winner = i;
+      }
+    }
+  }
+
+  scratch_.update(model_, best.params);
+  double conf = confidence(input, scratch_);
+  low_confidence_run_ = conf < config_.lost_confidence ? low_confidence_run_ + 1 : 0;
+  if (low_confidence_run_ >= config_.lost_frames && previous_) {
+    // The fit is clearly wrong: start again from the open hand on this very frame.
+    frame.previous = frame.before_previous = nullptr;
+    best = start();
+    winner = -1;
+    scratch_.update(model_, best.params);
+    conf = confidence(input, scratch_);
+    recovering_ = true;
+    low_confidence_run_ = 0;
+    before_previous_.reset();
+  } else if (conf >= config_.lost_confidence) {
+    recovering_ = false;
+  }
+  before_previous_ = previous_;
+  previous_ = best.params;
+  auto out = describe(best.params, best.energy, input, recovering_ ? TrackingState::kRecovering : TrackingState::kTracking);
+  out.confidence = conf;
+  out.winning_particle = winner;
+  return out;
+}
+
+TrackerOutput PoseTracker::describe(const PoseParams& params, double energy, const DepthInput& /*input*/,
+                                    TrackingState state) {
+  TrackerOutput out;
+  out.state = state;
+  out.params = params;
+  out.energy = energy;
+  scratch_.update(model_, params);
+  out.joints = scratch_.joints();
+  for (int f = 0; f < kNumFingers; ++f) out.fingertips[static_cast<size_t>(f)] = scratch_.fingertip(f);
+  out.palm_centre = scratch_.to_camera(model_.palm_centre());
+  out.palm_normal = scratch_.camera_R_hand() * Vector3d::UnitZ();
+  // Tip Gaussians are the last of each finger's list: surface distance = centre distance - radii.
+  const auto tip_sigma = [&](int finger) {
+    return model_.gaussians()[static_cast<size_t>(kBonesPerFinger * 2 * finger + 5)].sigma_mm;
+  };
+  out.pinch_distance_mm = std::max(0.0, (out.fingertips[kThumb] - out.fingertips[kIndex]).norm() -
+                                            tip_sigma(kThumb) - tip_sigma(kIndex));
+  out.pinch_strength = std::clamp(1.0 - out.pinch_distance_mm / kPinchOpenMm, 0.0, 1.0);
+  return out;
+}
+
+}  // namespace handtrack
