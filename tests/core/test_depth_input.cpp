@@ -1,0 +1,172 @@
+// Property tests of the depth input (Sec. 3.1): working volume, segmentation, quadtree leaves.
+#include "handtrack/core/depth_input.hpp"
+#include "handtrack/core/kinematics.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace handtrack {
+namespace {
+
+CameraIntrinsics camera(int width, int height) {
+  CameraIntrinsics c;
+  const double s = width / 320.0;
+  c.width = width;
+  c.height = height;
+  c.fx = 224.502 * s;
+  c.fy = 230.494 * s;
+  c.cx = width / 2.0;
+  c.cy = height / 2.0;
+  return c;
+}
+
+// A "hand" blob: an elliptic bump at ~depth_mm in front of a body plane at 800 mm (outside the
+// working volume), with a forearm strip running to the bottom edge.
+DepthImage blob_scene(const CameraIntrinsics& cam, double depth_mm, bool forearm) {
+  DepthImage img{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 800.0F)};
+  const double s = cam.width / 320.0;
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      const double du = (u - cam.cx) / (28.0 * s);
+      const double dv = (v - cam.cy + 10 * s) / (40.0 * s);
+      const double r2 = du * du + dv * dv;
+      if (r2 < 1.0) img.at(u, v) = static_cast<float>(depth_mm - 12.0 * (1.0 - r2));
+      if (forearm && v > cam.cy + 20 * s && std::abs(u - cam.cx) < 18 * s) {
+        img.at(u, v) = static_cast<float>(depth_mm + 0.6 * (v - cam.cy - 20 * s) / s);
+      }
+    }
+  }
+  return img;
+}
+
+void expect_leaf_properties(const DepthInput& in, const DepthInputConfig& cfg) {
+  const int w = in.camera.width;
+  const int min_leaf = std::max(1, cfg.quadtree_min_leaf_px * std::max(1, w / 320));
+  std::vector<int> owner(in.hand_mask.size(), -1);
+  for (size_t k = 0; k < in.gaussians.size(); ++k) {
+    const auto& g = in.gaussians[k];
+    EXPECT_NEAR(g.sigma_px, g.side_px / std::sqrt(2.0), 1e-12);  // sigma = a / sqrt(2)
+    const int x0 = static_cast<int>(std::lround(g.u + 0.5 - 0.5 * g.side_px));
+    const int y0 = static_cast<int>(std::lround(g.v + 0.5 - 0.5 * g.side_px));
+    float lo = 1e9F;
+    float hi = 0.0F;
+    double sum = 0.0;
+    int n = 0;
+    for (int v = y0; v < std::min(y0 + g.side_px, in.camera.height); ++v) {
+      for (int u = x0; u < std::min(x0 + g.side_px, w); ++u) {
+        const auto i = static_cast<size_t>(v) * w + u;
+        EXPECT_EQ(owner[i], -1) << "leaves overlap";
+        owner[i] = static_cast<int>(k);
+        if (!in.hand_mask[i]) continue;
+        lo = std::min(lo, in.filtered_mm[i]);
+        hi = std::max(hi, in.filtered_mm[i]);
+        sum += in.filtered_mm[i];
+        ++n;
+      }
+    }
+    ASSERT_GT(n, 0);
+    EXPECT_NEAR(g.depth_mm, sum / n, 1e-3);  // d_q = mean depth of the leaf
+    if (g.side_px > min_leaf) {
+      EXPECT_LT(hi - lo, cfg.quadtree_threshold_mm);  // epsilon_c
+    }
+  }
+}
+
+TEST(DepthInput, QuadtreeLeavesAreFlatDisjointAndMeanDepthAt320And640) {
+  for (const auto& cam : {camera(320, 240), camera(640, 480)}) {
+    DepthInputBuilder builder;
+    const auto& in = builder.build(blob_scene(cam, 400, false), std::nullopt);
+    ASSERT_TRUE(in.has_hand()) << cam.width;
+    EXPECT_GT(in.gaussians.size(), 10U);
+    expect_leaf_properties(in, builder.config());
+  }
+}
+
+TEST(DepthInput, SteepSurfacesSplitFinerThanFlatOnes) {
+  const auto cam = camera(320, 240);
+  DepthImage flat{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 0.0F)};
+  DepthImage steep = flat;
+  for (int v = 80; v < 160; ++v) {
+    for (int u = 120; u < 200; ++u) {
+      flat.at(u, v) = 400.0F;
+      steep.at(u, v) = static_cast<float>(400 + 2.0 * (u - 120));  // 2 mm per pixel
+    }
+  }
+  DepthInputBuilder a;
+  DepthInputBuilder b;
+  const size_t n_flat = a.build(flat, std::nullopt).gaussians.size();
+  const size_t n_steep = b.build(steep, std::nullopt).gaussians.size();
+  EXPECT_LT(n_flat, n_steep / 4);
+  expect_leaf_properties(b.last(), b.config());
+}
+
+TEST(DepthInput, NothingInsideTheWorkingVolumeMeansNoHand) {
+  const auto cam = camera(320, 240);
+  DepthInputBuilder builder;
+  DepthImage zeros{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 0.0F)};
+  EXPECT_FALSE(builder.build(zeros, std::nullopt).has_hand());
+  DepthImage far{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 900.0F)};
+  EXPECT_FALSE(builder.build(far, std::nullopt).has_hand());
+  DepthImage max_range{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 65535.0F)};
+  EXPECT_FALSE(builder.build(max_range, std::nullopt).has_hand());
+  DepthImage nan{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, std::nanf(""))};
+  EXPECT_FALSE(builder.build(nan, std::nullopt).has_hand());
+}
+
+TEST(DepthInput, MedianFilterRemovesFlyingPixels) {
+  const auto cam = camera(320, 240);
+  DepthImage img = blob_scene(cam, 400, false);
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> u(0, cam.width - 1);
+  std::uniform_int_distribution<int> v(0, cam.height - 1);
+  for (int k = 0; k < 300; ++k) img.at(u(rng), v(rng)) = 250.0F;  // isolated pixels in the volume
+  DepthInputBuilder builder;
+  const auto& in = builder.build(img, std::nullopt);
+  ASSERT_TRUE(in.has_hand());
+  for (const auto& g : in.gaussians) EXPECT_GT(g.depth_mm, 370.0);
+}
+
+TEST(DepthInput, ForearmIsCutAtTheWrist) {
+  const auto cam = camera(320, 240);
+  const DepthImage img = blob_scene(cam, 400, true);
+  DepthInputBuilder builder;
+  // The tracker's hint: wrist just below the blob, fingers up the image.
+  const Eigen::Vector3d wrist = cam.unproject(cam.cx, cam.cy + 32, 400);
+  const HandHint hint{cam.unproject(cam.cx, cam.cy - 10, 400), wrist, Eigen::Vector3d(0, -1, 0)};
+  const auto& in = builder.build(img, hint);
+  ASSERT_TRUE(in.has_hand());
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      if (!in.hand_mask[static_cast<size_t>(v) * cam.width + u]) continue;
+      const Eigen::Vector3d p = cam.unproject(u, v, in.filtered_mm[static_cast<size_t>(v) * cam.width + u]);
+      EXPECT_GT((p - wrist).dot(hint.finger_axis), -11.0);
+    }
+  }
+  // Without a hint the blob's far end from the image border is taken as the hand.
+  DepthInputBuilder fresh;
+  const auto& first = fresh.build(img, std::nullopt);
+  ASSERT_TRUE(first.has_hand());
+  EXPECT_LT(first.finger_axis.y(), -0.8);  // fingers point up the image, away from the arm
+}
+
+TEST(Projection, UnprojectInvertsProjectAndSigmaScalesWithInverseDepth) {
+  const auto cam = camera(640, 480);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> x(-100, 100);
+  std::uniform_real_distribution<double> z(150, 600);
+  for (int k = 0; k < 100; ++k) {
+    const Eigen::Vector3d p(x(rng), x(rng), z(rng));
+    const auto uv = cam.project(p);
+    EXPECT_LT((cam.unproject(uv.x(), uv.y(), p.z()) - p).norm(), 1e-9);
+  }
+  // Scaled orthographic (Sec. 3.2): a sphere of radius sigma at depth z spans ~sigma f / z pixels.
+  const Eigen::Vector3d c(0, 0, 400);
+  const double sigma = 10.0;
+  const double span = cam.project(c + Eigen::Vector3d(sigma, 0, 0)).x() - cam.project(c).x();
+  EXPECT_NEAR(span, sigma * cam.fx / c.z(), 1e-9);
+}
+
+}  // namespace
+}  // namespace handtrack

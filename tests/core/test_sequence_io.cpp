@@ -1,0 +1,157 @@
+// The sequence directory of SPEC.md and PNG files: round trips, and bad input giving one clear
+// error that names the file.
+#include "handtrack/core/png_io.hpp"
+#include "handtrack/core/sequence.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace handtrack {
+namespace {
+namespace fs = std::filesystem;
+
+class SequenceIo : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("handtrack_seq_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Writes a 2-frame 32x24 sequence; returns its camera.
+  CameraIntrinsics write_small() {
+    CameraIntrinsics cam;
+    cam.width = 32;
+    cam.height = 24;
+    cam.fx = cam.fy = 30;
+    cam.cx = 16;
+    cam.cy = 12;
+    cam.depth_scale_mm = 0.125;
+    SequenceWriter w(dir_, cam);
+    for (int f = 0; f < 2; ++f) {
+      DepthImage d{cam, std::vector<float>(32 * 24, 0.0F)};
+      for (size_t i = 0; i < d.depth_mm.size(); ++i) d.depth_mm[i] = static_cast<float>(300.0 + 0.125 * (i % 50) + f);
+      w.write_depth(f, d);
+      Fingertips tips;
+      tips[kThumb] = Eigen::Vector3d(1.5, -2.25, 400.125);
+      if (f == 1) tips[kLittle] = Eigen::Vector3d(-30, 10, 420);
+      w.write_fingertips(f, tips);
+      Joints joints;
+      for (int j = 0; j < kNumJoints; ++j) joints[static_cast<size_t>(j)] = Eigen::Vector3d(j, -j, 400 + j);
+      w.write_joints(f, joints);
+      w.write_labels(f, Gray8Image{32, 24, 1, std::vector<uint8_t>(32 * 24, static_cast<uint8_t>(f + 3))});
+    }
+    return cam;
+  }
+  void write_text(const fs::path& file, const std::string& text) { std::ofstream(file) << text; }
+
+  // Expects `fn` to throw a runtime_error whose message contains `needle` and the file name.
+  template <typename Fn>
+  void expect_error(Fn&& fn, const std::string& file, const std::string& needle) {
+    try {
+      fn();
+      FAIL() << "no error for " << file;
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(file), std::string::npos) << what;
+      EXPECT_NE(what.find(needle), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+    }
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(SequenceIo, RoundTripKeepsDepthGroundTruthJointsAndLabels) {
+  const auto cam = write_small();
+  const SequenceReader r(dir_);
+  ASSERT_EQ(r.frame_count(), 2U);
+  EXPECT_EQ(r.camera().width, 32);
+  EXPECT_DOUBLE_EQ(r.camera().depth_scale_mm, 0.125);
+  const DepthImage d = r.depth(1);
+  for (size_t i = 0; i < d.depth_mm.size(); ++i) EXPECT_FLOAT_EQ(d.depth_mm[i], 300.0F + 0.125F * (i % 50) + 1.0F);
+  const auto tips0 = r.fingertips(0);
+  ASSERT_TRUE(tips0[kThumb].has_value());
+  EXPECT_NEAR((*tips0[kThumb] - Eigen::Vector3d(1.5, -2.25, 400.125)).norm(), 0.0, 1e-3);
+  EXPECT_FALSE(tips0[kLittle].has_value());  // empty cells = not annotated
+  EXPECT_TRUE(r.fingertips(1)[kLittle].has_value());
+  const auto joints = r.joints(1);
+  ASSERT_TRUE(joints.has_value());
+  EXPECT_NEAR((*joints)[20].z(), 420.0, 1e-9);
+  const auto labels = r.labels(1);
+  ASSERT_TRUE(labels.has_value());
+  EXPECT_EQ(labels->pixels[100], 4);
+  (void)cam;
+}
+
+TEST_F(SequenceIo, MissingOrCorruptFilesGiveOneClearError) {
+  write_small();
+  fs::remove(dir_ / "depth" / "000001.png");
+  {
+    std::ofstream(dir_ / "depth" / "000001.png") << "this is not a png";
+    const SequenceReader r(dir_);
+    expect_error([&] { (void)r.depth(1); }, "000001.png", "not a readable PNG");
+  }
+  {
+    // A truncated PNG: the header survives, the data does not.
+    const auto good = dir_ / "depth" / "000000.png";
+    std::ifstream in(good, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    std::ofstream(dir_ / "depth" / "000001.png", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+    const SequenceReader r(dir_);
+    expect_error([&] { (void)r.depth(1); }, "000001.png", "PNG");
+  }
+  {
+    write_png_gray16(dir_ / "depth" / "000001.png", Gray16Image{16, 16, 1, std::vector<uint16_t>(256, 1)});
+    const SequenceReader r(dir_);
+    expect_error([&] { (void)r.depth(1); }, "000001.png", "camera.json says 32x24");
+  }
+  expect_error([&] { (void)read_png_gray16(dir_ / "nope.png"); }, "nope.png", "no such file");
+  write_png_rgb(dir_ / "rgb.png", RgbImage{4, 4, 3, std::vector<uint8_t>(48, 9)});
+  expect_error([&] { (void)read_png_gray16(dir_ / "rgb.png"); }, "rgb.png", "grayscale");
+}
+
+TEST_F(SequenceIo, BadCameraJsonNamesTheField) {
+  write_small();
+  const auto cam = dir_ / "camera.json";
+  write_text(cam, R"({"width":320,"height":240,"fx":224.5,"cx":160,"cy":120})");
+  expect_error([&] { SequenceReader r(dir_); }, "camera.json", "'fy'");
+  write_text(cam, R"({"width":320,"height":240,"fx":"big","fy":1,"cx":160,"cy":120})");
+  expect_error([&] { SequenceReader r(dir_); }, "camera.json", "'fx' must be a number");
+  write_text(cam, R"({"width":0,"height":240,"fx":224.5,"fy":224.5,"cx":160,"cy":120})");
+  expect_error([&] { SequenceReader r(dir_); }, "camera.json", "width");
+  write_text(cam, R"({"width":320,"height":240,"fx":224.5,"fy":224.5,"cx":160,"cy":120,"depth_scale_mm":-1})");
+  expect_error([&] { SequenceReader r(dir_); }, "camera.json", "depth_scale_mm");
+  write_text(cam, "{ not json");
+  expect_error([&] { SequenceReader r(dir_); }, "camera.json", "not valid JSON");
+  fs::remove(cam);
+  expect_error([&] { SequenceReader r(dir_); }, "camera.json", "cannot open");
+  expect_error([&] { SequenceReader r(dir_ / "missing"); }, "missing", "not a directory");
+}
+
+TEST_F(SequenceIo, BadGroundTruthNamesTheLine) {
+  write_small();
+  write_text(dir_ / "groundtruth.csv", "frame,thumb_x\n0,1,2\n");
+  expect_error([&] { SequenceReader r(dir_); }, "groundtruth.csv", "line 2");
+  write_text(dir_ / "groundtruth.csv", "0,a,2,3,,,,,,,,,,,,\n");
+  expect_error([&] { SequenceReader r(dir_); }, "groundtruth.csv", "'a' is not a number");
+}
+
+TEST(RealData, Sr305FrameLoadsWithItsDepthUnit) {
+  const fs::path file = fs::path(HANDTRACK_SHARED_DATA_DIR) / "real-sr305/20210326-230536/110.png";
+  if (!fs::exists(file)) GTEST_SKIP() << "shared data absent: " << file;
+  CameraIntrinsics cam{640, 480, 476.007, 476.007, 313.683, 242.755, 0.125, 30};
+  const auto raw = read_png_gray16(file);
+  ASSERT_EQ(raw.width, 640);
+  const DepthImage d = DepthImage::from_raw(cam, raw.pixels);
+  // The hand is at roughly 450-800 mm: a good share of the pixels must fall there.
+  size_t in_range = 0;
+  for (float v : d.depth_mm) in_range += (v > 400 && v < 900) ? 1 : 0;
+  EXPECT_GT(in_range, d.depth_mm.size() / 20);
+}
+
+}  // namespace
+}  // namespace handtrack
