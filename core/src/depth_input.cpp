@@ -21,6 +21,36 @@ constexpr double kWristCutMarginMm = 10.0;
 // Pixels this close to the image border mark the end of a blob where the arm leaves the image.
 constexpr int kBorderPx = 3;
 
+// Two-pass 3-4 chamfer distance transform in place: nonzero cells get their distance (in thirds of
+// a pixel) to the nearest zero cell.
+void chamfer_distance(std::vector<int>& d, int w, int h) {
+  const auto at = [&](int u, int v) -> int& { return d[static_cast<size_t>(v) * w + u]; };
+  const auto relax = [&](int u, int v, int du, int dv, int cost) {
+    const int uu = u + du;
+    const int vv = v + dv;
+    const int other = (uu < 0 || vv < 0 || uu >= w || vv >= h) ? 0 : at(uu, vv);
+    at(u, v) = std::min(at(u, v), other + cost);
+  };
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      if (at(u, v) == 0) continue;
+      relax(u, v, -1, 0, 3);
+      relax(u, v, 0, -1, 3);
+      relax(u, v, -1, -1, 4);
+      relax(u, v, 1, -1, 4);
+    }
+  }
+  for (int v = h - 1; v >= 0; --v) {
+    for (int u = w - 1; u >= 0; --u) {
+      if (at(u, v) == 0) continue;
+      relax(u, v, 1, 0, 3);
+      relax(u, v, 0, 1, 3);
+      relax(u, v, 1, 1, 4);
+      relax(u, v, -1, 1, 4);
+    }
+  }
+}
+
 int scaled_px(int px_at_320, int width) { return std::max(1, px_at_320 * std::max(1, width / 320)); }
 
 }  // namespace
@@ -209,12 +239,20 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
       lo = -lo;
       hi = -hi;
     }
-    const double tip = hi;
+    // The palm centre is the hand pixel farthest from the hand's outline (the centre of the largest
+    // inscribed disc): the palm is the widest part of a hand, open or closed, and wider than the
+    // forearm. Search within one hand length of the tip.
     const double length = config_.hand_length_mm;
-    // The palm centre lies ~0.6 hand lengths below the fingertips; a blob shorter than a hand is
-    // all hand (a fist, or no forearm in view).
-    centre = (hi - lo) > length ? mean + axis * (tip - 0.6 * length) : mean;
-    wrist = (hi - lo) > length ? mean + axis * (tip - length) : mean + axis * (lo - kWristCutMarginMm);
+    std::vector<int>& dist = stack_;
+    dist.assign(n, 0);
+    for (size_t i = 0; i < n; ++i) {
+      if (component_[i] == best && (point(i) - mean).dot(axis) >= hi - length) dist[i] = 1 << 20;
+    }
+    chamfer_distance(dist, w, h);
+    const auto centre_px = static_cast<size_t>(std::max_element(dist.begin(), dist.end()) - dist.begin());
+    centre = point(centre_px);
+    // The wrist sits about half a palm (a quarter of the hand length) below the palm centre.
+    wrist = centre - axis * (0.25 * length);
     count = select();
   }
   out_.hand_pixels = count;

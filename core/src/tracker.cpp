@@ -9,8 +9,13 @@ namespace handtrack {
 using Eigen::Vector3d;
 
 namespace {
-// In-plane rotations (rad) tried around the segmented hand's axis when (re)starting.
+// (Re)start hypotheses: the open hand of Sec. 5 and, since a hand often enters or is lost as a
+// fist, a closed hand; each turned by a few in-plane rotations (rad) around the segmented axis.
 constexpr std::array<double, 3> kStartRotations = {0.0, 0.4, -0.4};
+constexpr std::array<bool, 2> kStartClosed = {false, true};
+// Closed hand: [abd, flex1, flex2, flex3] for the thumb, then for each finger.
+constexpr std::array<double, 4> kClosedThumb = {0.3, 0.6, 0.5, 0.5};
+constexpr std::array<double, 4> kClosedFinger = {0.0, 1.3, 1.5, 0.9};
 // Pinch strength falls from 1 (tips touching) to 0 at this surface distance.
 constexpr double kPinchOpenMm = 40.0;
 }  // namespace
@@ -49,13 +54,20 @@ std::optional<HandHint> PoseTracker::hint() const {
                   hand.camera_R_hand() * Vector3d::UnitY()};
 }
 
-PoseParams PoseTracker::initial_pose(const DepthInput& input, double in_plane_offset_rad) const {
+PoseParams PoseTracker::initial_pose(const DepthInput& input, double in_plane_offset_rad, bool closed) const {
   // Frontal open hand (r = 0: fingers toward -y in the image) turned in the image plane onto the
   // hand's axis: rotation phi about the camera z maps (0,-1) to (sin phi, -cos phi).
   const Vector3d& axis = input.finger_axis;
   const double phi = std::atan2(axis.x(), -axis.y()) + in_plane_offset_rad;
   PoseParams params = PoseParams::Zero();
   params.segment<3>(kRotationParam) = Vector3d(0, 0, phi);
+  if (closed) {
+    for (int f = 0; f < kNumFingers; ++f) {
+      for (int d = 0; d < 4; ++d) {
+        params[angle_param(f, d)] = (f == kThumb ? kClosedThumb : kClosedFinger)[static_cast<size_t>(d)];
+      }
+    }
+  }
   const PosedHand at_origin(model_, params);
   // The segmented palm centre is a surface point; the model's palm centre is half a palm inside.
   const double palm_half_thickness = model_.gaussians().back().sigma_mm;
@@ -129,9 +141,12 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   // (Re)start: the open hand at the segmented hand, a few in-plane rotations, the best energy wins.
   const auto start = [&]() {
     OptimizerResult best{PoseParams::Zero(), -1e300};
-    for (double offset : kStartRotations) {
-      auto r = optimizer_.maximise(energy_, frame, initial_pose(input, offset), scratch_, config_.init_iterations);
-      if (r.energy > best.energy) best = r;
+    for (bool closed : kStartClosed) {
+      for (double offset : kStartRotations) {
+        const auto r = optimizer_.maximise(energy_, frame, initial_pose(input, offset, closed), scratch_,
+                                           config_.init_iterations);
+        if (r.energy > best.energy) best = r;
+      }
     }
     return best;
   };

@@ -66,8 +66,10 @@ class PoseTracker {
   [[nodiscard]] const HandModel& model() const { return model_; }
   [[nodiscard]] const TrackerConfig& config() const { return config_; }
   void set_scale(const HandScale& scale);
-  // Open hand placed at the segmented hand of `input` (Sec. 5's start pose).
-  [[nodiscard]] PoseParams initial_pose(const DepthInput& input, double in_plane_offset_rad = 0.0) const;
+  // Open (or closed) hand placed at the segmented hand of `input` (Sec. 5's start pose), turned by
+  // `in_plane_offset_rad` about the camera axis.
+  [[nodiscard]] PoseParams initial_pose(const DepthInput& input, double in_plane_offset_rad = 0.0,
+                                        bool closed = false) const;
   // How much of the segmented hand the posed model explains, in [0, 1].
   [[nodiscard]] double confidence(const DepthInput& input, const PosedHand& hand) const;
 

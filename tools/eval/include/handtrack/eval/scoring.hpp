@@ -1,0 +1,53 @@
+#pragma once
+// The paper's metrics (Sec. 7, "Error Metrics"): per frame, the mean Euclidean distance over the
+// annotated fingertips; per sequence, the mean of that over the scored frames and the percentage of
+// frames with an error below 15, 20, 25 and 30 mm (after Qian et al. 2014).
+
+#include "handtrack/core/sequence.hpp"
+#include "handtrack/core/tracker.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace handtrack::eval {
+
+inline constexpr std::array<int, 4> kThresholdsMm = {15, 20, 25, 30};
+
+// Mean distance (mm) between the tracked and the annotated fingertips; NaN when no fingertip is
+// annotated. A frame without a pose (state no_hand) scores +infinity: it is below no threshold.
+double fingertip_error_mm(const TrackerOutput& out, const Fingertips& truth);
+
+struct SequenceScore {
+  std::string name;
+  int frames = 0;              // frames tracked
+  int scored = 0;              // frames with annotations and a pose
+  int without_pose = 0;        // annotated frames where the tracker reported no hand
+  int nan_poses = 0;           // frames whose pose had a non-finite number (must stay 0)
+  double mean_error_mm = 0.0;  // over scored frames
+  double max_error_mm = 0.0;
+  std::array<double, kThresholdsMm.size()> pct_below{};  // over annotated frames
+  double fps = 0.0;            // single-threaded tracking rate (preprocessing + optimisation)
+  std::vector<double> per_frame_error_mm;  // NaN = not annotated, inf = no pose
+};
+
+// Accumulates one sequence's frames.
+class SequenceScorer {
+ public:
+  explicit SequenceScorer(std::string name) { score_.name = std::move(name); }
+  void add(const TrackerOutput& out, const Fingertips& truth);
+  SequenceScore finish(double tracking_seconds);
+
+ private:
+  SequenceScore score_;
+};
+
+// All frames of all sequences pooled (the paper's overall figures).
+SequenceScore overall(const std::vector<SequenceScore>& sequences);
+
+// SPEC.md "Evaluation output".
+nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const SequenceScore& total);
+
+}  // namespace handtrack::eval

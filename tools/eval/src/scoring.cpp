@@ -1,0 +1,108 @@
+#include "handtrack/eval/scoring.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace handtrack::eval {
+
+double fingertip_error_mm(const TrackerOutput& out, const Fingertips& truth) {
+  double sum = 0.0;
+  int n = 0;
+  for (int f = 0; f < kNumFingers; ++f) {
+    const auto& t = truth[static_cast<size_t>(f)];
+    if (!t) continue;
+    sum += (out.fingertips[static_cast<size_t>(f)] - *t).norm();
+    ++n;
+  }
+  if (n == 0) return std::numeric_limits<double>::quiet_NaN();
+  if (out.state == TrackingState::kNoHand) return std::numeric_limits<double>::infinity();
+  return sum / n;
+}
+
+void SequenceScorer::add(const TrackerOutput& out, const Fingertips& truth) {
+  ++score_.frames;
+  if (!out.params.allFinite()) ++score_.nan_poses;
+  score_.per_frame_error_mm.push_back(fingertip_error_mm(out, truth));
+}
+
+namespace {
+// Fills the statistics of `s` from its per-frame errors.
+void summarise(SequenceScore& s) {
+  double sum = 0.0;
+  int annotated = 0;
+  s.scored = s.without_pose = 0;
+  s.max_error_mm = 0.0;
+  std::array<int, kThresholdsMm.size()> below{};
+  for (double e : s.per_frame_error_mm) {
+    if (std::isnan(e)) continue;
+    ++annotated;
+    if (std::isinf(e)) {
+      ++s.without_pose;
+      continue;
+    }
+    ++s.scored;
+    sum += e;
+    s.max_error_mm = std::max(s.max_error_mm, e);
+    for (size_t k = 0; k < kThresholdsMm.size(); ++k) below[k] += e < kThresholdsMm[k] ? 1 : 0;
+  }
+  s.mean_error_mm = s.scored > 0 ? sum / s.scored : std::numeric_limits<double>::quiet_NaN();
+  for (size_t k = 0; k < kThresholdsMm.size(); ++k) {
+    s.pct_below[k] = annotated > 0 ? 100.0 * below[k] / annotated : 0.0;
+  }
+}
+}  // namespace
+
+SequenceScore SequenceScorer::finish(double tracking_seconds) {
+  summarise(score_);
+  score_.fps = tracking_seconds > 0.0 ? score_.frames / tracking_seconds : 0.0;
+  return score_;
+}
+
+SequenceScore overall(const std::vector<SequenceScore>& sequences) {
+  SequenceScore all;
+  all.name = "overall";
+  double seconds = 0.0;
+  for (const auto& s : sequences) {
+    all.frames += s.frames;
+    all.nan_poses += s.nan_poses;
+    all.per_frame_error_mm.insert(all.per_frame_error_mm.end(), s.per_frame_error_mm.begin(),
+                                  s.per_frame_error_mm.end());
+    if (s.fps > 0.0) seconds += s.frames / s.fps;
+  }
+  summarise(all);
+  all.fps = seconds > 0.0 ? all.frames / seconds : 0.0;
+  return all;
+}
+
+nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const SequenceScore& total) {
+  const auto pct = [](const SequenceScore& s) {
+    nlohmann::json j = nlohmann::json::object();
+    for (size_t k = 0; k < kThresholdsMm.size(); ++k) j[std::to_string(kThresholdsMm[k])] = s.pct_below[k];
+    return j;
+  };
+  const auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  nlohmann::json out;
+  out["sequences"] = nlohmann::json::array();
+  for (const auto& s : sequences) {
+    out["sequences"].push_back({{"name", s.name},
+                                {"frames", s.frames},
+                                {"frames_scored", s.scored},
+                                {"frames_without_pose", s.without_pose},
+                                {"nan_poses", s.nan_poses},
+                                {"mean_fingertip_error_mm", number(s.mean_error_mm)},
+                                {"max_fingertip_error_mm", number(s.max_error_mm)},
+                                {"pct_frames_below_mm", pct(s)},
+                                {"fps", s.fps}});
+  }
+  out["overall"] = {{"frames", total.frames},
+                    {"frames_scored", total.scored},
+                    {"frames_without_pose", total.without_pose},
+                    {"nan_poses", total.nan_poses},
+                    {"mean_fingertip_error_mm", number(total.mean_error_mm)},
+                    {"pct_frames_below_mm", pct(total)},
+                    {"fps", total.fps}};
+  return out;
+}
+
+}  // namespace handtrack::eval
