@@ -1,0 +1,207 @@
+/*
+ * handtrack/client.h: the stable C API for reading hand poses from handtrackd's shared memory.
+ *
+ * A client maps the daemon's POSIX shared-memory object read-only; it can never block or corrupt
+ * the daemon. Typical use:
+ *
+ *     handtrack_client* c = NULL;
+ *     int st = handtrack_open(NULL, &c);            // NULL = the default name "handtrack"
+ *     if (st != HANDTRACK_OK) { fprintf(stderr, "%s\n", handtrack_strerror(st)); return 1; }
+ *     handtrack_pose pose;
+ *     for (;;) {
+ *       st = handtrack_wait_next(c, &pose, 1000000000);   // wait at most 1 s
+ *       if (st == HANDTRACK_OK) use(&pose);
+ *       else if (st < 0 && st != HANDTRACK_ERR_WRITER_DEAD && st != HANDTRACK_ERR_WRITER_STOPPED) break;
+ *     }
+ *     handtrack_close(c);
+ *
+ * Status values: HANDTRACK_OK (0), positive "nothing yet" values (HANDTRACK_TIMEOUT,
+ * HANDTRACK_NO_RECORD) and negative errors. No function throws, allocates after handtrack_open, or
+ * blocks longer than its timeout.
+ *
+ * Thread safety: one handtrack_client belongs to one thread at a time; distinct clients are
+ * independent. handtrack_strerror and handtrack_abi_version may be called from any thread.
+ *
+ * ABI: the record and header layouts are fixed for a given HANDTRACK_ABI_VERSION; a client refuses
+ * a segment whose magic, ABI version, record size or layout differ (see docs/IPC.md).
+ */
+#ifndef HANDTRACK_CLIENT_H
+#define HANDTRACK_CLIENT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(_WIN32)
+#define HANDTRACK_API
+#elif defined(HANDTRACK_CLIENT_BUILDING)
+#define HANDTRACK_API __attribute__((visibility("default")))
+#else
+#define HANDTRACK_API
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Version of the shared-memory layout (header, slot and record). Bumped on any layout change. */
+#define HANDTRACK_ABI_VERSION 1u
+/* Default shared-memory object name (shm_open name without the leading slash). */
+#define HANDTRACK_DEFAULT_SHM_NAME "handtrack"
+
+#define HANDTRACK_NUM_PARAMS 26    /* pose parameters (paper: 26 degrees of freedom) */
+#define HANDTRACK_NUM_JOINTS 21    /* wrist, then per finger thumb..little: MCP/CMC, PIP, DIP, TIP */
+#define HANDTRACK_NUM_FINGERTIPS 5 /* thumb, index, middle, ring, little */
+
+typedef enum handtrack_status {
+  HANDTRACK_OK = 0,
+  HANDTRACK_TIMEOUT = 1,   /* no new record within the timeout; the writer is alive */
+  HANDTRACK_NO_RECORD = 2, /* the writer has not published any record yet */
+  HANDTRACK_ERR_INVALID_ARGUMENT = -1,
+  HANDTRACK_ERR_NOT_FOUND = -2,      /* no shared-memory object with that name (daemon not running) */
+  HANDTRACK_ERR_PERMISSION = -3,     /* not allowed to open it (group membership?) */
+  HANDTRACK_ERR_NOT_READY = -4,      /* the writer is still initializing the segment */
+  HANDTRACK_ERR_BAD_MAGIC = -5,      /* not a handtrack segment */
+  HANDTRACK_ERR_BAD_ENDIANNESS = -6, /* written by a machine of the other byte order */
+  HANDTRACK_ERR_BAD_VERSION = -7,    /* different ABI version: rebuild the client */
+  HANDTRACK_ERR_BAD_RECORD_SIZE = -8,
+  HANDTRACK_ERR_BAD_LAYOUT = -9,     /* header sizes or capacity inconsistent */
+  HANDTRACK_ERR_TRUNCATED = -10,     /* the object is smaller than its header says */
+  HANDTRACK_ERR_WRITER_DEAD = -11,   /* heartbeat stale: the daemon died or hangs */
+  HANDTRACK_ERR_WRITER_STOPPED = -12, /* the daemon stopped cleanly */
+  HANDTRACK_ERR_BUSY = -13,          /* the writer overwrote the slot during every read attempt */
+  HANDTRACK_ERR_SYSTEM = -14         /* an unexpected system call failure (see handtrack_error_detail) */
+} handtrack_status;
+
+typedef enum handtrack_tracking_state {
+  HANDTRACK_STATE_NO_HAND = 0,
+  HANDTRACK_STATE_TRACKING = 1,
+  HANDTRACK_STATE_RECOVERING = 2
+} handtrack_tracking_state;
+
+typedef enum handtrack_device_state {
+  HANDTRACK_DEVICE_STOPPED = 0,            /* writer exited cleanly (or never started streaming) */
+  HANDTRACK_DEVICE_STARTING = 1,           /* segment created, source being opened */
+  HANDTRACK_DEVICE_WAITING_FOR_DEVICE = 2, /* no camera yet: waiting for one to be plugged in */
+  HANDTRACK_DEVICE_STREAMING = 3,          /* frames are flowing */
+  HANDTRACK_DEVICE_ERROR = 4               /* the source failed; the daemon keeps retrying */
+} handtrack_device_state;
+
+/*
+ * One pose: 640 bytes, trivially copyable, fixed-width fields, no implicit padding, native byte
+ * order. Positions are millimetres in the camera frame (x right, y down, z forward); times are
+ * CLOCK_MONOTONIC nanoseconds of the machine running the daemon.
+ */
+typedef struct handtrack_pose {
+  uint64_t frame;      /* daemon frame number (counts grabbed frames within an epoch) */
+  uint64_t epoch;      /* writer epoch: grows with each daemon start (stamped by the writer) */
+  int64_t capture_ns;  /* when the depth frame was captured */
+  int64_t publish_ns;  /* when the record was published (stamped by the writer) */
+  float grab_ms;       /* per-stage timings of this frame */
+  float preprocess_ms;
+  float optimize_ms;
+  float publish_ms;
+  int32_t state;       /* handtrack_tracking_state */
+  float confidence;    /* 0..1 */
+  float energy;        /* final value of the optimized energy (lower is better) */
+  uint32_t flags;      /* reserved, 0 */
+  /* The 26 pose parameters as the tracker optimizes them (double: the optimizer's precision,
+   * round-trips exactly): params[0..2] global translation mm, params[3..5] global rotation rad,
+   * params[6..25] joint angles rad (see docs/IPC.md for the order). */
+  double params[HANDTRACK_NUM_PARAMS];
+  float joints_mm[HANDTRACK_NUM_JOINTS][3];
+  float fingertips_mm[HANDTRACK_NUM_FINGERTIPS][3]; /* thumb, index, middle, ring, little */
+  float palm_center_mm[3];
+  float palm_normal[3];        /* unit vector, pointing out of the palm */
+  float pinch_distance_mm;     /* thumb tip to index tip */
+  float pinch_strength;        /* 0 (open) .. 1 (touching) */
+  float hand_scale[3];         /* hand-model scale factors: length, width, Gaussian sigma (1 = default) */
+  uint32_t reserved[3];        /* 0; pads the record to 640 bytes */
+} handtrack_pose;
+
+/* Live statistics of the daemon, refreshed about once a second. */
+typedef struct handtrack_stats {
+  float fps;                /* published frames per second */
+  float grab_ms;            /* mean per-stage times over the last interval */
+  float preprocess_ms;
+  float optimize_ms;
+  float publish_ms;
+  float latency_p50_ms;     /* capture to publish */
+  float latency_p99_ms;
+  uint32_t reserved;
+  uint64_t frames_captured; /* since the daemon started */
+  uint64_t frames_dropped;  /* captured but never processed (the pipeline was busy) */
+  uint64_t frames_skipped;  /* processed but not published (e.g. invalid depth) */
+  uint64_t source_errors;   /* failures reported by the depth source */
+} handtrack_stats;
+
+typedef struct handtrack_writer_status {
+  int32_t device_state;      /* handtrack_device_state */
+  int32_t alive;             /* 1 if the heartbeat is fresh and the writer has not stopped */
+  int32_t writer_pid;        /* in the writer's pid namespace */
+  uint32_t capacity;         /* records in the ring */
+  uint64_t epoch;
+  uint64_t records_published; /* in this epoch */
+  int64_t heartbeat_ns;       /* CLOCK_MONOTONIC of the last heartbeat */
+  int64_t heartbeat_age_ns;   /* now - heartbeat_ns, as seen by this client */
+  int64_t heartbeat_period_ns;
+  handtrack_stats stats;
+} handtrack_writer_status;
+
+/* The layout is part of the ABI: these sizes never change within one HANDTRACK_ABI_VERSION. */
+#if defined(__cplusplus)
+static_assert(sizeof(handtrack_pose) == 640, "handtrack_pose layout changed");
+static_assert(sizeof(handtrack_stats) == 64, "handtrack_stats layout changed");
+static_assert(sizeof(handtrack_writer_status) == 120, "handtrack_writer_status layout changed");
+#elif defined(__STDC_VERSION__) && __STDC_VERSION__ >= 201112L
+_Static_assert(sizeof(handtrack_pose) == 640, "handtrack_pose layout changed");
+_Static_assert(sizeof(handtrack_stats) == 64, "handtrack_stats layout changed");
+_Static_assert(sizeof(handtrack_writer_status) == 120, "handtrack_writer_status layout changed");
+#endif
+
+typedef struct handtrack_client handtrack_client; /* opaque */
+
+/* Opens (maps read-only) the segment `shm_name` (NULL: "handtrack"). On success *out is a client
+ * that must be closed with handtrack_close. Waiting for records starts after the newest record
+ * present at open time. On failure *out is NULL and the status says why. */
+HANDTRACK_API int handtrack_open(const char* shm_name, handtrack_client** out);
+HANDTRACK_API void handtrack_close(handtrack_client* client);
+
+/* Copies the newest record. HANDTRACK_NO_RECORD if none was published yet. Never blocks. */
+HANDTRACK_API int handtrack_latest(handtrack_client* client, handtrack_pose* out);
+
+/* Waits at most timeout_ns (0: do not wait) for the next record after the last one returned and
+ * copies it. Records are returned in order; records overwritten before they could be read are
+ * counted by handtrack_missed. If the writer dies or stops, returns HANDTRACK_ERR_WRITER_DEAD or
+ * _STOPPED once, as soon as it is seen (within 3 heartbeat periods); later calls wait for a new
+ * writer, reattach to it by themselves and continue with its records (a new epoch). */
+HANDTRACK_API int handtrack_wait_next(handtrack_client* client, handtrack_pose* out, int64_t timeout_ns);
+
+/* Like handtrack_wait_next but returns the newest record, skipping (and counting) older ones. */
+HANDTRACK_API int handtrack_wait_latest(handtrack_client* client, handtrack_pose* out, int64_t timeout_ns);
+
+/* Records skipped just before the record returned by the last successful read, and since open. */
+HANDTRACK_API uint64_t handtrack_missed(const handtrack_client* client);
+HANDTRACK_API uint64_t handtrack_missed_total(const handtrack_client* client);
+
+/* The writer's state, epoch, heartbeat and live statistics. */
+HANDTRACK_API int handtrack_writer_status_get(handtrack_client* client, handtrack_writer_status* out);
+
+/* A constant English sentence for a status value. */
+HANDTRACK_API const char* handtrack_strerror(int status);
+/* Details of the last failure in this thread (e.g. the sizes that did not match); never NULL. */
+HANDTRACK_API const char* handtrack_error_detail(void);
+/* "no_hand", "tracking", "recovering" (or "unknown"). */
+HANDTRACK_API const char* handtrack_state_name(int32_t tracking_state);
+/* "stopped", "starting", "waiting_for_device", "streaming", "error" (or "unknown"). */
+HANDTRACK_API const char* handtrack_device_state_name(int32_t device_state);
+
+/* What the library was built with, for bindings to check their layout against. */
+HANDTRACK_API uint32_t handtrack_abi_version(void);
+HANDTRACK_API size_t handtrack_pose_size(void);
+HANDTRACK_API size_t handtrack_writer_status_size(void);
+
+#ifdef __cplusplus
+} /* extern "C" */
+#endif
+
+#endif /* HANDTRACK_CLIENT_H */
