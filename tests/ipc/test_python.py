@@ -1,0 +1,134 @@
+#!/usr/bin/env python3
+"""The Python module reads real records from a real writer process, field by field.
+
+Environment (set by ctest): HANDTRACK_CLIENT_LIB, PYTHONPATH (clients/python), IPC_TEST_WRITER,
+HANDTRACK_EXAMPLE (clients/python/examples/print_poses.py).
+"""
+import ctypes
+import os
+import subprocess
+import sys
+import time
+
+import handtrack
+
+failures = []
+
+
+def check(condition, message):
+    if not condition:
+        failures.append(message)
+        print("FAIL:", message, file=sys.stderr)
+
+
+def checksum(pose):
+    """FNV-1a 32 of the record with epoch, publish_ns and params[25] zeroed (test_pattern.hpp)."""
+    copy = handtrack.Pose.from_buffer_copy(bytes(pose))
+    copy.epoch = 0
+    copy.publish_ns = 0
+    copy.params[25] = 0.0
+    h = 2166136261
+    for b in bytes(copy):
+        h = ((h ^ b) * 16777619) & 0xFFFFFFFF
+    return h
+
+
+def expected_record(frame):
+    """make_test_record() of tests/ipc/test_pattern.hpp, in Python."""
+    f = float(frame % 1000)
+    base = float(frame % 4096)
+    return {
+        "capture_ns": frame * 1000 + 7,
+        "grab_ms": f * 0.25, "preprocess_ms": f * 0.25 + 1, "optimize_ms": f * 0.25 + 2,
+        "publish_ms": f * 0.25 + 3,
+        "state": frame % 3, "confidence": (frame % 100) / 128.0, "energy": f * 0.5,
+        "params": [frame + k * 0.5 for k in range(25)],
+        "joints_mm": [[base + j * 3 + a for a in range(3)] for j in range(21)],
+        "fingertips_mm": [[base + 100 + t * 3 + a for a in range(3)] for t in range(5)],
+        "palm_center_mm": [base + 200 + a for a in range(3)],
+        "palm_normal": [0.0, 0.0, -1.0],
+        "pinch_distance_mm": (frame % 256) * 0.5, "pinch_strength": (frame % 4) * 0.25,
+        "hand_scale": [1.0 + (frame % 8) * 0.125, 1.25, 0.75],
+    }
+
+
+def check_pose(pose, epoch):
+    e = expected_record(pose.frame)
+    where = f"frame {pose.frame}"
+    check(pose.epoch == epoch, f"{where}: epoch {pose.epoch} != {epoch}")
+    check(pose.publish_ns > 0, f"{where}: publish_ns not stamped")
+    for key in ("capture_ns", "grab_ms", "preprocess_ms", "optimize_ms", "publish_ms", "state",
+                "energy", "pinch_distance_mm", "pinch_strength"):
+        check(getattr(pose, key) == e[key], f"{where}: {key} {getattr(pose, key)} != {e[key]}")
+    check(abs(pose.confidence - e["confidence"]) < 1e-7, f"{where}: confidence")
+    check(list(pose.params)[:25] == e["params"], f"{where}: params")
+    check(pose.params[25] == float(checksum(pose)), f"{where}: checksum")
+    check([list(j) for j in pose.joints_mm] == e["joints_mm"], f"{where}: joints")
+    check([list(t) for t in pose.fingertips_mm] == e["fingertips_mm"], f"{where}: fingertips")
+    check(list(pose.palm_center_mm) == e["palm_center_mm"], f"{where}: palm centre")
+    check(list(pose.palm_normal) == e["palm_normal"], f"{where}: palm normal")
+    check(list(pose.hand_scale) == e["hand_scale"], f"{where}: hand scale")
+    d = pose.to_dict()
+    check(d["state"] in ("no_hand", "tracking", "recovering"), f"{where}: state name")
+    check(len(d["params"]) == 26 and len(d["joints"]) == 21 and len(d["fingertips"]) == 5,
+          f"{where}: dict shape")
+
+
+def main():
+    name = f"ht_py_{os.getpid()}"
+    try:
+        handtrack.Client(name)
+        check(False, "opening a missing segment must raise")
+    except handtrack.HandtrackError as e:
+        check(e.status == -2 and name in str(e), f"missing segment error: {e}")
+
+    writer = subprocess.Popen([os.environ["IPC_TEST_WRITER"], "--name", name, "--rate-hz", "500",
+                               "--capacity", "64"], stdout=subprocess.PIPE, text=True)
+    try:
+        ready = writer.stdout.readline().split()
+        check(ready[:1] == ["ready"], f"writer did not start: {ready}")
+        epoch = int(ready[1])
+        with handtrack.Client(name) as client:
+            status = client.status()
+            check(status.alive == 1 and status.epoch == epoch and status.capacity == 64,
+                  "writer status")
+            frames = []
+            deadline = time.monotonic() + 10
+            while len(frames) < 100 and time.monotonic() < deadline:
+                pose = client.wait_next(timeout=1.0)
+                check(pose is not None, "wait_next returned a pose")
+                if pose is None:
+                    break
+                check_pose(pose, epoch)
+                frames.append(pose.frame)
+            check(len(frames) == 100, f"read {len(frames)} poses")
+            check(frames == list(range(frames[0], frames[0] + len(frames))) or client.missed_total > 0,
+                  "in order, or the skips were counted")
+            latest = client.latest()
+            check(latest is not None and latest.frame >= frames[-1], "latest")
+            # The example script runs against the same writer.
+            example = subprocess.run([sys.executable, os.environ["HANDTRACK_EXAMPLE"],
+                                      "--shm-name", name, "--count", "3"],
+                                     capture_output=True, text=True, timeout=30)
+            check(example.returncode == 0 and example.stdout.count("frame ") == 3,
+                  f"example: {example.returncode} {example.stdout!r} {example.stderr!r}")
+            writer.terminate()
+            writer.wait(timeout=10)
+            # The writer marked the segment stopped: the client says so instead of waiting.
+            pose = client.wait_next(timeout=2.0)
+            while pose is not None:
+                pose = client.wait_next(timeout=2.0)
+            check(client.trouble == handtrack.ERR_WRITER_STOPPED, f"trouble {client.trouble}")
+    finally:
+        if writer.poll() is None:
+            writer.kill()
+        try:
+            os.unlink(f"/dev/shm/{name}")
+        except FileNotFoundError:
+            pass
+    print(f"python client: {len(failures)} failed checks")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
