@@ -1,0 +1,324 @@
+#include "render.hpp"
+
+#include "handtrack/core/kinematics.hpp"
+#include "handtrack/draw/canvas.hpp"
+#include "handtrack/draw/colormap.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <stdexcept>
+#include <vector>
+
+namespace handtrack::view {
+namespace {
+
+using draw::Canvas;
+using draw::Rgb;
+
+constexpr int kCropPanelHeightPx = 360;
+constexpr double kCropMarginFraction = 0.3;  // of the hand's larger bounding-box side, each way
+constexpr int kPanelGapPx = 4;
+constexpr Rgb kFrameBackground{20, 20, 20};
+constexpr Rgb kCaptionText{235, 235, 235};
+constexpr Rgb kMaskTint{40, 220, 90};
+constexpr double kMaskAlpha = 0.45;
+constexpr double kModelAlpha = 0.6;
+constexpr double kSkeletonFingerAxisMm = 60.0;  // length of the drawn finger-axis estimate
+
+std::string format(const char* fmt, double v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
+// Maps image pixels (centres at integers) onto a panel: the region starting at (u0, v0) scaled by s.
+struct ViewMap {
+  double u0 = 0.0;
+  double v0 = 0.0;
+  double s = 1.0;
+  int width = 0;
+  int height = 0;
+  [[nodiscard]] double x(double u) const { return (u - u0 + 0.5) * s - 0.5; }
+  [[nodiscard]] double y(double v) const { return (v - v0 + 0.5) * s - 0.5; }
+  [[nodiscard]] int u_of(int x_px) const { return static_cast<int>(std::floor((x_px + 0.5) / s + u0)); }
+  [[nodiscard]] int v_of(int y_px) const { return static_cast<int>(std::floor((y_px + 0.5) / s + v0)); }
+};
+
+ViewMap make_view(const DepthInput& input, const RenderOptions& options) {
+  const int w = input.camera.width;
+  const int h = input.camera.height;
+  ViewMap view;
+  int lo_u = w, lo_v = h, hi_u = -1, hi_v = -1;
+  if (options.crop) {
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        if (input.hand_mask[static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u)] == 0) continue;
+        lo_u = std::min(lo_u, u);
+        hi_u = std::max(hi_u, u);
+        lo_v = std::min(lo_v, v);
+        hi_v = std::max(hi_v, v);
+      }
+    }
+  }
+  if (hi_u < 0) {  // the whole image
+    view.height = options.panel_height > 0 ? options.panel_height : h;
+    view.s = static_cast<double>(view.height) / h;
+    view.width = std::max(1, static_cast<int>(std::lround(w * view.s)));
+    return view;
+  }
+  const double side = std::max(hi_u - lo_u + 1, hi_v - lo_v + 1) * (1.0 + 2.0 * kCropMarginFraction);
+  view.u0 = 0.5 * (lo_u + hi_u + 1) - 0.5 * side;
+  view.v0 = 0.5 * (lo_v + hi_v + 1) - 0.5 * side;
+  view.height = options.panel_height > 0 ? options.panel_height : kCropPanelHeightPx;
+  view.width = view.height;
+  view.s = view.height / side;
+  return view;
+}
+
+// Robust display range of the measured depth: the 2nd and 98th percentiles.
+std::pair<double, double> depth_range(const std::vector<float>& depth_mm) {
+  std::vector<float> valid;
+  valid.reserve(depth_mm.size());
+  for (float d : depth_mm) {
+    if (d > 0.0F && std::isfinite(d)) valid.push_back(d);
+  }
+  if (valid.empty()) return {0.0, 1.0};
+  const auto at = [&valid](double q) {
+    auto k = static_cast<size_t>(q * static_cast<double>(valid.size() - 1));
+    std::nth_element(valid.begin(), valid.begin() + static_cast<std::ptrdiff_t>(k), valid.end());
+    return static_cast<double>(valid[k]);
+  };
+  const double near = at(0.02);
+  const double far = at(0.98);
+  return {near, std::max(far, near + 1.0)};
+}
+
+// The depth image in gray (near = bright) through the view; `dim` < 1 darkens it.
+void draw_depth(Canvas& c, const ViewMap& view, const DepthImage& depth, std::pair<double, double> range,
+                double dim = 1.0) {
+  for (int y = 0; y < view.height; ++y) {
+    const int v = view.v_of(y);
+    for (int x = 0; x < view.width; ++x) {
+      const int u = view.u_of(x);
+      if (u < 0 || v < 0 || u >= depth.width() || v >= depth.height()) continue;
+      const Rgb g = draw::depth_gray(depth.at(u, v), range.first, range.second);
+      c.set_pixel(x, y, dim < 1.0 ? draw::shade(g, dim) : g);
+    }
+  }
+}
+
+bool in_mask(const DepthInput& in, int u, int v) {
+  if (u < 0 || v < 0 || u >= in.camera.width || v >= in.camera.height) return false;
+  return in.hand_mask[static_cast<size_t>(v) * static_cast<size_t>(in.camera.width) + static_cast<size_t>(u)] != 0;
+}
+
+// The outline of the segmented hand: panel pixels inside the mask with a neighbour outside, so the
+// fitted model can be judged against the hand it was fitted to.
+void draw_mask_outline(Canvas& c, const ViewMap& view, const DepthInput& in) {
+  for (int y = 0; y < view.height; ++y) {
+    for (int x = 0; x < view.width; ++x) {
+      if (!in_mask(in, view.u_of(x), view.v_of(y))) continue;
+      const bool edge = !in_mask(in, view.u_of(x - 1), view.v_of(y)) || !in_mask(in, view.u_of(x + 1), view.v_of(y)) ||
+                        !in_mask(in, view.u_of(x), view.v_of(y - 1)) || !in_mask(in, view.u_of(x), view.v_of(y + 1));
+      if (edge) c.set_pixel(x, y, kMaskTint);
+    }
+  }
+}
+
+struct Panel {
+  Canvas canvas;
+  std::string caption;
+};
+
+int caption_scale(int panel_width) { return panel_width >= 560 ? 2 : 1; }
+
+Panel depth_panel(const FrameView& f, const ViewMap& view, std::pair<double, double> range) {
+  Canvas c(view.width, view.height, draw::colours::kBlack);
+  draw_depth(c, view, *f.depth, range);
+  const DepthInput& in = *f.input;
+  for (int y = 0; y < view.height; ++y) {
+    for (int x = 0; x < view.width; ++x) {
+      if (in_mask(in, view.u_of(x), view.v_of(y))) c.blend_pixel(x, y, kMaskTint, kMaskAlpha);
+    }
+  }
+  if (in.has_hand() && in.palm_centre_mm.z() > 1.0) {
+    // The preprocessing's palm centre and wrist-to-fingers axis, as a cross and a line.
+    const auto palm = in.camera.project(in.palm_centre_mm);
+    const auto tip = in.camera.project(in.palm_centre_mm + kSkeletonFingerAxisMm * in.finger_axis);
+    const double px = view.x(palm.x()), py = view.y(palm.y());
+    c.line(px - 6, py, px + 6, py, draw::colours::kYellow, 2);
+    c.line(px, py - 6, px, py + 6, draw::colours::kYellow, 2);
+    c.line(px, py, view.x(tip.x()), view.y(tip.y()), draw::colours::kYellow);
+  }
+  Panel p{std::move(c), {}};
+  p.caption = f.name + "\ndepth " + format("%.0f", range.first) + format("-%.0f mm", range.second) +
+              format(", hand %.0f px", in.hand_pixels);
+  return p;
+}
+
+Panel quadtree_panel(const FrameView& f, const ViewMap& view, std::pair<double, double> range) {
+  Canvas c(view.width, view.height, draw::colours::kBlack);
+  draw_depth(c, view, *f.depth, range, 0.3);
+  const auto& gs = f.input->gaussians;
+  const bool labelled = std::any_of(gs.begin(), gs.end(), [](const ImageGaussian& g) { return g.label != 0; });
+  double near = 1e9, far = -1e9;
+  for (const auto& g : gs) {
+    near = std::min(near, g.depth_mm);
+    far = std::max(far, g.depth_mm);
+  }
+  for (const auto& g : gs) {  // the leaf squares, faint
+    // The leaf covers image pixels from (u - side/2 + 1/2) on; its left edge lands on panel pixel
+    // (first - u0) * s.
+    const double first_u = g.u - 0.5 * g.side_px + 0.5;
+    const double first_v = g.v - 0.5 * g.side_px + 0.5;
+    const int x0 = static_cast<int>(std::lround((first_u - view.u0) * view.s));
+    const int y0 = static_cast<int>(std::lround((first_v - view.v0) * view.s));
+    const int side = std::max(1, static_cast<int>(std::lround(g.side_px * view.s)));
+    c.rect(x0, y0, side, side, Rgb{70, 70, 70});
+  }
+  for (const auto& g : gs) {
+    const Rgb colour = labelled ? draw::part_colour(g.label) : draw::depth_turbo(g.depth_mm, near, far);
+    c.circle(view.x(g.u), view.y(g.v), g.sigma_px * view.s, colour);
+    c.fill_circle(view.x(g.u), view.y(g.v), std::max(1.0, 0.12 * g.sigma_px * view.s), colour);
+  }
+  Panel p{std::move(c), {}};
+  p.caption = format("quadtree: %.0f Gaussians", static_cast<double>(gs.size()));
+  if (!gs.empty()) {
+    p.caption += labelled ? "\nby label" : format("\nturbo %.0f", near) + format("-%.0f mm (red=near)", far);
+  }
+  return p;
+}
+
+Panel model_panel(const FrameView& f, const ViewMap& view, std::pair<double, double> range) {
+  Canvas c(view.width, view.height, draw::colours::kBlack);
+  draw_depth(c, view, *f.depth, range, 0.55);
+  const TrackerOutput& out = *f.output;
+  const CameraIntrinsics& cam = f.input->camera;
+  draw_mask_outline(c, view, *f.input);
+  const bool posed = out.state != TrackingState::kNoHand && out.params.allFinite();
+  if (posed) {
+    const PosedHand hand(*f.model, out.params);
+    // Scaled orthographic projection of Sec. 3.2: centre projected, sigma_p = sigma_h f / z.
+    std::vector<int> order(static_cast<size_t>(hand.gaussian_count()));
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&hand](int a, int b) { return hand.centre(a).z() > hand.centre(b).z(); });
+    const auto& model_gaussians = f.model->gaussians();
+    for (int i : order) {
+      const Eigen::Vector3d& p = hand.centre(i);
+      if (!(p.z() > 1.0)) continue;
+      const auto& mg = model_gaussians[static_cast<size_t>(i)];
+      const auto uv = cam.project(p);
+      const double r = mg.sigma_mm * cam.focal() / p.z() * view.s;
+      const Rgb colour = draw::part_colour(mg.label);
+      c.fill_circle(view.x(uv.x()), view.y(uv.y()), r, colour, kModelAlpha);
+      c.circle(view.x(uv.x()), view.y(uv.y()), r, draw::shade(colour, 0.5));
+    }
+    const auto to_panel = [&](const Eigen::Vector3d& p) {
+      const auto uv = cam.project(p);
+      return Eigen::Vector2d(view.x(uv.x()), view.y(uv.y()));
+    };
+    const int thick = view.width >= 560 ? 3 : 2;
+    const Eigen::Vector2d wrist = to_panel(out.joints[kWristJoint]);
+    for (int finger = 0; finger < kNumFingers; ++finger) {
+      Eigen::Vector2d prev = wrist;
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector2d q = to_panel(out.joints[static_cast<size_t>(joint_index(finger, k))]);
+        c.line(prev.x(), prev.y(), q.x(), q.y(), draw::colours::kWhite, thick);
+        prev = q;
+      }
+    }
+    for (const auto& j : out.joints) {
+      const Eigen::Vector2d q = to_panel(j);
+      c.fill_circle(q.x(), q.y(), thick, draw::colours::kWhite);
+    }
+    for (int finger = 0; finger < kNumFingers; ++finger) {
+      const Eigen::Vector2d q = to_panel(out.fingertips[static_cast<size_t>(finger)]);
+      c.fill_circle(q.x(), q.y(), 2.0 * thick, draw::part_colour(part_label(finger, 2)));
+      c.circle(q.x(), q.y(), 2.0 * thick, draw::colours::kBlack);
+    }
+  }
+  if (f.truth_tips != nullptr) {  // annotated fingertips: cyan crosses
+    for (const auto& tip : *f.truth_tips) {
+      if (!tip || !(tip->z() > 1.0)) continue;
+      const auto uv = cam.project(*tip);
+      const double x = view.x(uv.x()), y = view.y(uv.y());
+      c.line(x - 5, y - 5, x + 5, y + 5, Rgb{0, 230, 255}, 2);
+      c.line(x - 5, y + 5, x + 5, y - 5, Rgb{0, 230, 255}, 2);
+    }
+  }
+  Panel p{std::move(c), {}};
+  p.caption = std::string("model: ") + to_string(out.state);
+  if (posed) p.caption += format("  conf %.2f", out.confidence) + format("  E %.3g", out.energy);
+  if (f.truth_tips != nullptr) {
+    if (const auto err = fingertip_error_mm(out, *f.truth_tips); err && posed) {
+      p.caption += format("\ntip error %.1f mm (x = truth)", *err);
+    }
+  }
+  return p;
+}
+
+Panel labels_panel(const FrameView& f, const ViewMap& view, std::pair<double, double> range) {
+  Canvas c(view.width, view.height, draw::colours::kBlack);
+  draw_depth(c, view, *f.depth, range, 0.35);
+  const Gray8Image& labels = *f.labels;
+  for (int y = 0; y < view.height; ++y) {
+    const int v = view.v_of(y);
+    for (int x = 0; x < view.width; ++x) {
+      const int u = view.u_of(x);
+      if (u < 0 || v < 0 || u >= labels.width || v >= labels.height) continue;
+      const int label = labels.pixels[static_cast<size_t>(v) * static_cast<size_t>(labels.width) + static_cast<size_t>(u)];
+      if (label != 0) c.set_pixel(x, y, draw::part_colour(label));
+    }
+  }
+  // Legend: the 12 part colours in a row along the bottom edge.
+  const int sw = std::max(6, view.width / 40);
+  for (int label = 1; label <= kNumPartLabels; ++label) {
+    c.fill_rect(4 + (label - 1) * (sw + 2), view.height - sw - 4, sw, sw, draw::part_colour(label));
+  }
+  return {std::move(c), f.labels_caption};
+}
+
+}  // namespace
+
+std::optional<double> fingertip_error_mm(const TrackerOutput& output, const Fingertips& truth) {
+  double sum = 0.0;
+  int n = 0;
+  for (int i = 0; i < kNumFingers; ++i) {
+    const auto& t = truth[static_cast<size_t>(i)];
+    if (!t) continue;
+    sum += (output.fingertips[static_cast<size_t>(i)] - *t).norm();
+    ++n;
+  }
+  if (n == 0) return std::nullopt;
+  return sum / n;
+}
+
+RgbImage render_frame(const FrameView& f, const RenderOptions& options) {
+  if (f.depth == nullptr || f.input == nullptr || f.output == nullptr || f.model == nullptr) {
+    throw std::invalid_argument("render_frame: depth, input, output and model are required");
+  }
+  const ViewMap view = make_view(*f.input, options);
+  const auto range = depth_range(f.depth->depth_mm);
+  std::vector<Panel> panels;
+  panels.push_back(depth_panel(f, view, range));
+  panels.push_back(quadtree_panel(f, view, range));
+  panels.push_back(model_panel(f, view, range));
+  if (f.labels != nullptr) panels.push_back(labels_panel(f, view, range));
+
+  const int scale = caption_scale(view.width);
+  int caption_px = 0;
+  for (const auto& p : panels) caption_px = std::max(caption_px, draw::text_height(p.caption, scale));
+  caption_px += 8;
+  const int n = static_cast<int>(panels.size());
+  Canvas out(n * view.width + (n + 1) * kPanelGapPx, caption_px + view.height + kPanelGapPx, kFrameBackground);
+  for (int i = 0; i < n; ++i) {
+    const int x = kPanelGapPx + i * (view.width + kPanelGapPx);
+    out.text(x + 2, 4, panels[static_cast<size_t>(i)].caption, kCaptionText, scale);
+    out.blit(panels[static_cast<size_t>(i)].canvas, x, caption_px);
+  }
+  return out.image();
+}
+
+}  // namespace handtrack::view
