@@ -16,6 +16,7 @@ constexpr std::array<bool, 2> kStartClosed = {false, true};
 // Closed hand: [abd, flex1, flex2, flex3] for the thumb, then for each finger.
 constexpr std::array<double, 4> kClosedThumb = {0.3, 0.6, 0.5, 0.5};
 constexpr std::array<double, 4> kClosedFinger = {0.0, 1.3, 1.5, 0.9};
+constexpr double kClosedFingersInFrontMm = 40.0;
 // Pinch strength falls from 1 (tips touching) to 0 at this surface distance.
 constexpr double kPinchOpenMm = 40.0;
 }  // namespace
@@ -70,8 +71,11 @@ PoseParams PoseTracker::initial_pose(const DepthInput& input, double in_plane_of
   }
   const PosedHand at_origin(model_, params);
   // The segmented palm centre is a surface point; the model's palm centre is half a palm inside.
+  // A closed hand shows its curled fingers, which lie in front of the palm by about two finger
+  // thicknesses.
   const double palm_half_thickness = model_.gaussians().back().sigma_mm;
-  const Vector3d target = input.palm_centre_mm + Vector3d(0, 0, palm_half_thickness);
+  const double behind_surface = palm_half_thickness + (closed ? kClosedFingersInFrontMm : 0.0);
+  const Vector3d target = input.palm_centre_mm + Vector3d(0, 0, behind_surface);
   params.segment<3>(kTranslationParam) = target - at_origin.camera_R_hand() * model_.palm_centre();
   return params;
 }
@@ -139,13 +143,22 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   }
   EnergyFrame frame{&model_, &input, nullptr, nullptr};
   // (Re)start: the open hand at the segmented hand, a few in-plane rotations, the best energy wins.
+  // The hypotheses are compared by confidence, not energy: E_sim has no notion of occlusion, so
+  // a wrong pose that pushes the big palm Gaussians onto the visible surface can out-score the right
+  // one (seen on fists), while it explains little of the hand's outline.
   const auto start = [&]() {
     OptimizerResult best{PoseParams::Zero(), -1e300};
+    double best_confidence = -1.0;
     for (bool closed : kStartClosed) {
       for (double offset : kStartRotations) {
         const auto r = optimizer_.maximise(energy_, frame, initial_pose(input, offset, closed), scratch_,
                                            config_.init_iterations);
-        if (r.energy > best.energy) best = r;
+        scratch_.update(model_, r.params);
+        const double c = confidence(input, scratch_);
+        if (c > best_confidence + 1e-9 || (c > best_confidence - 1e-9 && r.energy > best.energy)) {
+          best = r;
+          best_confidence = c;
+        }
       }
     }
     return best;

@@ -127,14 +127,7 @@ int main(int argc, char** argv) {
       draw::write_error_plot(plot_file, series);
     }
     // A human-readable table on stdout: the paper's Table 1 in our numbers.
-    std::printf("%-14s %7s %9s %6s %6s %6s %6s %8s\n", "sequence", "frames", "mean_mm", "<15", "<20", "<25", "<30",
-                "fps");
-    const auto row = [](const eval::SequenceScore& s) {
-      std::printf("%-14s %7d %9.2f %6.1f %6.1f %6.1f %6.1f %8.1f\n", s.name.c_str(), s.frames, s.mean_error_mm,
-                  s.pct_below[0], s.pct_below[1], s.pct_below[2], s.pct_below[3], s.fps);
-    };
-    for (const auto& s : scores) row(s);
-    row(total);
+    std::fputs(eval::format_table(scores, total).c_str(), stdout);
   } catch (const std::exception& e) {
     std::cerr << "handtrack-eval: " << e.what() << "\n";
     return 1;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace handtrack::eval {
@@ -73,6 +74,22 @@ SequenceScore overall(const std::vector<SequenceScore>& sequences) {
   summarise(all);
   all.fps = seconds > 0.0 ? all.frames / seconds : 0.0;
   return all;
+}
+
+std::string format_table(const std::vector<SequenceScore>& sequences, const SequenceScore& total) {
+  std::string text;
+  char line[160];
+  std::snprintf(line, sizeof line, "%-14s %7s %9s %6s %6s %6s %6s %8s\n", "sequence", "frames", "mean_mm", "<15", "<20",
+                "<25", "<30", "fps");
+  text += line;
+  const auto row = [&](const SequenceScore& s) {
+    std::snprintf(line, sizeof line, "%-14s %7d %9.2f %6.1f %6.1f %6.1f %6.1f %8.1f\n", s.name.c_str(), s.frames,
+                  s.mean_error_mm, s.pct_below[0], s.pct_below[1], s.pct_below[2], s.pct_below[3], s.fps);
+    text += line;
+  };
+  for (const auto& s : sequences) row(s);
+  row(total);
+  return text;
 }
 
 nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const SequenceScore& total) {

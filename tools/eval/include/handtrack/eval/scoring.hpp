@@ -47,6 +47,9 @@ class SequenceScorer {
 // All frames of all sequences pooled (the paper's overall figures).
 SequenceScore overall(const std::vector<SequenceScore>& sequences);
 
+// The paper's Table 1 in our numbers: one row per sequence and the overall row, as text.
+std::string format_table(const std::vector<SequenceScore>& sequences, const SequenceScore& total);
+
 // SPEC.md "Evaluation output".
 nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const SequenceScore& total);
 
