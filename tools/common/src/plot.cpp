@@ -18,9 +18,10 @@ constexpr int kCaptionHeight = 24; // series name and statistics above the axes
 constexpr int kBottomMargin = 20;  // x tick labels
 constexpr int kCaptionScale = 2;
 // Automatic y range: at least up to 40 mm (above the paper's highest threshold, 30 mm), at most
-// 100 mm so that a lost frame does not flatten the interesting range; taller errors are clipped.
+// 60 mm so that a lost frame does not flatten the interesting range; taller errors are clipped
+// (and marked).
 constexpr double kAutoYMinMm = 40.0;
-constexpr double kAutoYMaxMm = 100.0;
+constexpr double kAutoYMaxMm = 60.0;
 
 constexpr Rgb kPlotBackground{255, 255, 255};
 constexpr Rgb kAxes{60, 60, 60};
@@ -71,17 +72,23 @@ void draw_axes(Canvas& c, const Axes& a, const PlotOptions& options, bool frame_
     const int y = static_cast<int>(std::lround(a.y(g)));
     for (int x = a.x0; x <= a.x1; x += 4) c.line(x, y, std::min(x + 1, a.x1), y, kGrid);
   }
-  for (double g : options.gridlines_mm) {
-    if (!(g > 0.0) || g > a.y_max) continue;
-    const std::string label = format("%.0f", g);
-    const int y = static_cast<int>(std::lround(a.y(g)));
-    c.text(a.x0 - 6 - text_width(label), y - kGlyphHeight / 2, label, kText);
-  }
-  for (double v : {0.0, a.y_max}) {
-    const std::string label = format("%.0f", v);
-    const int y = static_cast<int>(std::lround(a.y(v)));
-    c.text(a.x0 - 6 - text_width(label), y - kGlyphHeight / 2, label, kText);
+  // Tick labels: 0 and the top first, then the gridlines, each skipped if it would overlap one
+  // already drawn (close gridlines on a short panel).
+  std::vector<int> label_rows;
+  const auto label_at = [&](double mm) {
+    const int y = static_cast<int>(std::lround(a.y(mm)));
     c.line(a.x0 - 3, y, a.x0, y, kAxes);
+    for (int other : label_rows) {
+      if (std::abs(other - y) < kLineAdvance) return;
+    }
+    label_rows.push_back(y);
+    const std::string label = format("%.0f", mm);
+    c.text(a.x0 - 6 - text_width(label), y - kGlyphHeight / 2, label, kText);
+  };
+  label_at(0.0);
+  label_at(a.y_max);
+  for (double g : options.gridlines_mm) {
+    if (g > 0.0 && g < a.y_max) label_at(g);
   }
   c.text(4, a.y0 - 2, "mm", kText);
   // x ticks every "nice" number of frames.
@@ -93,7 +100,7 @@ void draw_axes(Canvas& c, const Axes& a, const PlotOptions& options, bool frame_
     const std::string label = format("%.0f", f);
     c.text(x - text_width(label) / 2, a.y1 + 6, label, kText);
   }
-  if (frame_label) c.text(a.x1 - text_width("frame"), a.y1 + 6 + kLineAdvance, "frame", kText);
+  if (frame_label) c.text(4, a.y1 + 6, "frame", kText);
   c.rect(a.x0, a.y0, a.x1 - a.x0 + 1, a.y1 - a.y0 + 1, kAxes);
 }
 

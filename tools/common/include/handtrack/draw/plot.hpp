@@ -18,8 +18,8 @@ struct ErrorSeries {
 struct PlotOptions {
   std::string title;                                   // drawn above the panels when not empty
   int width = 1000;                                    // image width, px
-  int panel_height = 170;                              // height of one panel, px
-  double y_max_mm = 0.0;                               // top of the y axis; 0 = automatic
+  int panel_height = 200;                              // height of one panel, px
+  double y_max_mm = 0.0;  // top of the y axis; 0 = automatic: the largest error rounded up to 10, in [40, 60]
   std::vector<double> gridlines_mm = {15, 20, 25, 30}; // the paper's thresholds (Sec. 7)
   bool overlay = false;  // false: one panel per series, stacked; true: all in one panel with a legend
 };
