@@ -1,0 +1,162 @@
+// handtrack-synth as a user runs it: bad arguments give one clear line and a non-zero exit; a run
+// writes a sequence directory that SequenceReader accepts and whose ground truth is consistent.
+
+#include "handtrack/core/sequence.hpp"
+
+#include <nlohmann/json.hpp>
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#ifndef HANDTRACK_SYNTH_EXE
+#error "HANDTRACK_SYNTH_EXE must name the handtrack-synth binary"
+#endif
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class SynthCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("handtrack-synth-test-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  RunResult run(const std::string& args) const {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = std::string("'") + HANDTRACK_SYNTH_EXE + "' " + args + " >'" + out.string() + "' 2>'" +
+                            err.string() + "' </dev/null";
+    const int status = std::system(cmd.c_str());
+    RunResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+  }
+
+  void expect_one_line_error(const std::string& args, const std::string& mentions) const {
+    SCOPED_TRACE(args);
+    const RunResult r = run(args);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_LT(r.exit_code, 128) << "crashed";
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "stderr: " << r.err;
+    EXPECT_NE(r.err.find(mentions), std::string::npos) << "stderr: " << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(SynthCli, BadArgumentsGiveOneClearLine) {
+  const std::string out = "--out '" + (dir_ / "seq").string() + "'";
+  expect_one_line_error("--motion moonwalk --frames 5 " + out, "moonwalk");
+  expect_one_line_error("--motion pinch --frames 0 " + out, "--frames");
+  expect_one_line_error("--motion pinch --frames many " + out, "--frames");
+  expect_one_line_error("--motion pinch --frames 5 --background wall " + out, "--background");
+  expect_one_line_error("--motion pinch --frames 5 --subject-scale 3,1 " + out, "--subject-scale");
+  expect_one_line_error("--motion pinch --frames 5 --subject-scale 1.0 " + out, "--subject-scale");
+  expect_one_line_error("--motion pinch --frames 5 --width 0 " + out, "--width");
+  expect_one_line_error("--motion pinch --frames 5", "--out");
+  expect_one_line_error("--frames 5 " + out, "--motion");
+  expect_one_line_error("--motion pinch --bogus " + out, "bogus");
+  EXPECT_FALSE(fs::exists(dir_ / "seq" / "depth"));
+}
+
+TEST_F(SynthCli, HelpAndListMotions) {
+  const RunResult help = run("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("--motion"), std::string::npos);
+  EXPECT_NE(help.out.find("--subject-scale"), std::string::npos);
+  const RunResult list = run("--list-motions");
+  EXPECT_EQ(list.exit_code, 0);
+  for (const char* m : {"adbadd", "fingercount", "fingerwave", "flexex1", "pinch", "random", "tigergrasp"}) {
+    EXPECT_NE(list.out.find(m), std::string::npos) << m;
+  }
+}
+
+TEST_F(SynthCli, Writes640x480SequenceWithConsistentGroundTruth) {
+  const fs::path seq = dir_ / "seq";
+  const RunResult r = run("--motion fingerwave --frames 12 --width 640 --height 480 --seed 5 --subject-scale 1.08,0.94 "
+                    "--out '" + seq.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << "stderr is not a terminal: no progress expected, got " << r.err;
+
+  const handtrack::SequenceReader reader(seq);
+  EXPECT_EQ(reader.frame_count(), 12u);
+  EXPECT_EQ(reader.camera().width, 640);
+  EXPECT_EQ(reader.camera().height, 480);
+  EXPECT_NEAR(reader.camera().fx, 449.004, 1e-6);
+  EXPECT_NEAR(reader.camera().fps, 60.0, 1e-9);
+  ASSERT_TRUE(reader.has_groundtruth());
+
+  const auto subject = nlohmann::json::parse(slurp(seq / "subject.json"));
+  EXPECT_DOUBLE_EQ(subject.at("length_scale").get<double>(), 1.08);
+  EXPECT_DOUBLE_EQ(subject.at("width_scale").get<double>(), 0.94);
+  const auto middle_bones = subject.at("fingers").at("middle").at("bone_lengths_mm");
+  EXPECT_NEAR(middle_bones[0].get<double>(), 46 * 1.08, 1e-9);
+
+  std::array<double, 15> first_lengths{};
+  for (size_t i = 0; i < reader.frame_count(); ++i) {
+    const auto depth = reader.depth(i);
+    const auto labels = reader.labels(i);
+    ASSERT_TRUE(labels.has_value());
+    EXPECT_EQ(labels->width, 640);
+    const auto joints = reader.joints(i);
+    ASSERT_TRUE(joints.has_value());
+    const auto tips = reader.fingertips(i);
+    for (int f = 0; f < handtrack::kNumFingers; ++f) {
+      ASSERT_TRUE(tips[static_cast<size_t>(f)].has_value());
+      EXPECT_LT((*tips[static_cast<size_t>(f)] - (*joints)[static_cast<size_t>(handtrack::fingertip_joint(f))]).norm(),
+                1e-6);
+      for (int b = 0; b < 3; ++b) {
+        const double len = ((*joints)[static_cast<size_t>(handtrack::joint_index(f, b + 1))] -
+                            (*joints)[static_cast<size_t>(handtrack::joint_index(f, b))])
+                               .norm();
+        const auto k = static_cast<size_t>(3 * f + b);
+        if (i == 0) first_lengths[k] = len;
+        EXPECT_NEAR(len, first_lengths[k], 0.01) << "bone length changes (csv has 3 decimals)";
+        EXPECT_NEAR(len, subject.at("fingers").at(std::string(handtrack::kFingerNames[static_cast<size_t>(f)]))
+                             .at("bone_lengths_mm")[static_cast<size_t>(b)].get<double>(), 0.01);
+      }
+    }
+    // Some hand in every frame: labelled pixels with depth.
+    size_t hand = 0;
+    for (size_t p = 0; p < labels->pixels.size(); ++p) hand += (labels->pixels[p] != 0 && depth.depth_mm[p] > 0);
+    EXPECT_GT(hand, 5000u);
+  }
+
+  // A second run into the same directory is refused without --force, accepted with it.
+  const std::string again = "--motion pinch --frames 3 --out '" + seq.string() + "'";
+  expect_one_line_error(again, "--force");
+  const RunResult forced = run(again + " --force --no-noise --background none");
+  EXPECT_EQ(forced.exit_code, 0) << forced.err;
+  EXPECT_EQ(handtrack::SequenceReader(seq).frame_count(), 3u);
+}
+
+}  // namespace

@@ -1,0 +1,114 @@
+#pragma once
+// The synthetic hand: a kinematic skeleton (the same definition the tracker's skeleton follows) and a
+// geometry of cone-spheres (capsules with possibly different end radii) that is deliberately NOT the
+// tracker's Gaussian mixture, so that tracking synthetic frames measures more than self-consistency.
+//
+// Frames (mm):
+//   hand frame   origin = wrist joint centre; x_h radial (thumb side), y_h distal (toward the
+//                fingers), z_h = x_h x y_h = out of the palm (palmar normal).
+//   camera frame x right, y down, z forward.
+//   camera_p = t + R hand_p,  R = exp(r) R0,  R0 = diag(1,-1,-1): r = 0 means palm facing the camera,
+//   fingers pointing up in the image (-y camera), thumb toward +x camera.
+//
+// Finger chain f (thumb..little): base b_f, rest direction d_f, palmar normal n_f, flexion axis
+// a_f = d_f x n_f, bone lengths L1..L3, angles [abd, flex1, flex2, flex3]:
+//   R_1 = Rot(n_f, abd) Rot(a_f, flex1);  j_1 = b_f + L1 R_1 d_f   (PIP; thumb MCP)
+//   R_2 = R_1 Rot(a_f, flex2);            j_2 = j_1 + L2 R_2 d_f   (DIP; thumb IP)
+//   R_3 = R_2 Rot(a_f, flex3);            j_3 = j_2 + L3 R_3 d_f   (TIP = centre of the tip sphere)
+// Rot(a, phi) d = d cos(phi) + (a x d) sin(phi) and a_f x d_f = n_f, so positive flexion moves the
+// finger toward n_f, i.e. toward the palm.
+
+#include "handtrack/core/hand_layout.hpp"
+#include "handtrack/core/sequence.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>  // cross()
+
+#include <array>
+#include <vector>
+
+namespace handtrack::synth {
+
+// Per finger [abd, flex1, flex2, flex3] in radians (thumb: abd, CMC, MCP, IP).
+using FingerAngles = std::array<double, 4>;
+
+// The 26 pose parameters of Sec. 3.2 in the order used by poses.csv:
+// t (3, mm), r (3, axis-angle, rad), then thumb..little [abd, flex1, flex2, flex3].
+struct HandPose {
+  Eigen::Vector3d translation_mm = Eigen::Vector3d::Zero();  // t: the wrist joint in the camera frame
+  Eigen::Vector3d rotation = Eigen::Vector3d::Zero();        // r: R = exp(r) R0
+  std::array<FingerAngles, kNumFingers> fingers{};
+
+  [[nodiscard]] Eigen::Matrix<double, kNumPoseParams, 1> to_params() const;
+  static HandPose from_params(const Eigen::Matrix<double, kNumPoseParams, 1>& params);
+};
+
+// R = exp(r) R0 with R0 = diag(1,-1,-1).
+Eigen::Matrix3d camera_R_hand(const Eigen::Vector3d& rotation);
+
+// Anatomical joint limits (radians) that every motion respects.
+struct JointLimits {
+  std::array<FingerAngles, kNumFingers> lower{};
+  std::array<FingerAngles, kNumFingers> upper{};
+
+  // thumb abd [-0.6,0.6], CMC [-0.4,0.9], MCP [-0.2,1.0], IP [-0.3,1.3];
+  // fingers abd [-0.35,0.35], MCP [-0.3,1.6], PIP [0,1.9], DIP [0,1.3].
+  static JointLimits defaults();
+  [[nodiscard]] HandPose clamp(HandPose pose) const;
+  [[nodiscard]] bool contains(const HandPose& pose, double tolerance = 1e-9) const;
+};
+
+// A subject's size relative to the mean adult hand: `length` scales bone lengths and the hand
+// frame's y coordinates, `width` scales x and z coordinates (finger bases, palm) and all radii.
+struct SubjectScale {
+  double length = 1.0;
+  double width = 1.0;
+};
+
+struct FingerShape {
+  Eigen::Vector3d base_mm = Eigen::Vector3d::Zero();  // b_f, hand frame
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitY();  // d_f, unit
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();     // n_f, unit, orthogonal to d_f
+  std::array<double, 3> bone_length_mm{};
+  // Skin radius at the base joint, the ends of bones 1 and 2, and the tip (each bone is a
+  // cone-sphere from one radius to the next).
+  std::array<double, 4> radius_mm{};
+
+  [[nodiscard]] Eigen::Vector3d flexion_axis() const { return direction.cross(normal); }
+};
+
+// A cone-sphere: the convex hull of the spheres (a, radius_a) and (b, radius_b); a == b is a sphere.
+struct ConeSphere {
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  double radius_a = 0.0;
+  double radius_b = 0.0;
+  int label = kBackground;  // hand_layout.hpp part label; 0 for the forearm
+};
+
+struct HandShape {
+  SubjectScale subject;
+  std::array<FingerShape, kNumFingers> fingers{};
+  std::vector<ConeSphere> palm;  // rigid in the hand frame, label kPalm (includes the wrist region)
+  ConeSphere forearm;            // rigid in the hand frame, label 0
+  Eigen::Vector3d palm_centre_mm = Eigen::Vector3d::Zero();  // hand frame; motions orbit around it
+
+  // The mean adult right hand (scale 1.0) of the module brief.
+  static HandShape mean_adult();
+  // mean_adult() scaled: lengths and y by subject.length, x, z and radii by subject.width.
+  static HandShape for_subject(const SubjectScale& subject);
+};
+
+// The 21 joints (SPEC.md order: wrist, then thumb..little MCP/CMC, PIP, DIP, TIP) in the hand frame.
+Joints hand_frame_joints(const HandShape& shape, const HandPose& pose);
+// The 21 joints in the camera frame (mm).
+Joints camera_frame_joints(const HandShape& shape, const HandPose& pose);
+// Fingertips (thumb..little; the TIP joints, i.e. the tip-sphere centres) in the camera frame.
+Fingertips fingertips_from_joints(const Joints& joints);
+
+// All primitives of the posed hand in the camera frame: 15 phalanges (labels from part_label()),
+// the palm and the forearm. `out` is cleared and refilled (no allocation once it has grown).
+void posed_primitives(const HandShape& shape, const HandPose& pose, const Joints& camera_joints,
+                      std::vector<ConeSphere>& out);
+
+}  // namespace handtrack::synth

@@ -1,0 +1,93 @@
+#pragma once
+// SyntheticCamera: renders depth frames with ground truth of a capsule hand performing one of the
+// Dexter 1 motions, with an optional sensor noise model and background. Used by handtrack-synth
+// (sequence directories) and by the daemon's `synthetic[:MOTION]` live source.
+//
+//   SyntheticCamera cam(SynthOptions{.motion = "pinch", .frames = 300});
+//   SynthFrame f;
+//   for (int i = 0; i < 300; ++i) cam.render(i, f);  // f.depth, f.labels, f.joints, f.fingertips
+//
+// Frames are a pure function of (options, frame index): random access, deterministic.
+// @thread A SyntheticCamera is not thread-safe (render() reuses internal buffers); use one per thread.
+
+#include "handtrack/core/camera.hpp"
+#include "handtrack/core/png_io.hpp"
+#include "handtrack/core/sequence.hpp"
+#include "handtrack/synth/hand_model.hpp"
+#include "handtrack/synth/motions.hpp"
+#include "handtrack/synth/noise.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace handtrack::synth {
+
+enum class Background {
+  kNone,   // only the hand and forearm
+  kBody,   // a torso plane 700-850 mm away (and a head), the forearm reaching toward it
+  kTable,  // a plane tilted like a table top, below and behind the hand (>= ~600 mm in view)
+};
+std::string_view background_name(Background background);
+std::optional<Background> parse_background(std::string_view name);
+
+// The SPEC.md camera (fx 224.502, fy 230.494 at 320x240, principal point at the image centre,
+// 60 fps, 1 mm depth units) with the focal lengths scaled to width x height.
+CameraIntrinsics default_camera(int width = 320, int height = 240);
+
+struct SynthOptions {
+  std::string motion = "flexex1";       // one of kMotionNames
+  int frames = 300;                     // sequence length: slow first half, fast second half
+  uint64_t seed = 1;                    // subject (when not given), noise
+  std::optional<SubjectScale> subject;  // nullopt: length and width scale drawn from the seed in [0.9, 1.1]
+  bool noise = true;
+  Background background = Background::kBody;
+  CameraIntrinsics camera = default_camera();
+  NoiseParams noise_params;
+};
+
+struct SynthFrame {
+  int frame = 0;
+  HandPose pose;
+  DepthImage depth;      // mm, 0 = no measurement (noisy when options.noise)
+  Gray8Image labels;     // part labels of hand_layout.hpp; 0 = background, forearm, or no depth
+  Joints joints;         // 21 joints, mm, camera frame (TIP = tip-sphere centre)
+  Fingertips fingertips;  // the 5 TIP joints, all present
+};
+
+class SyntheticCamera {
+ public:
+  // Throws std::invalid_argument for an unknown motion, frames < 1, unusable intrinsics or a subject
+  // scale outside [0.5, 2].
+  explicit SyntheticCamera(SynthOptions options);
+  ~SyntheticCamera();
+  SyntheticCamera(SyntheticCamera&&) noexcept;
+  SyntheticCamera& operator=(SyntheticCamera&&) noexcept;
+  SyntheticCamera(const SyntheticCamera&) = delete;
+  SyntheticCamera& operator=(const SyntheticCamera&) = delete;
+
+  // Renders frame i (any i >= 0; past options.frames the motion plays back and forth) into `out`,
+  // reusing its buffers: no allocation once `out` has the right size.
+  void render(int frame, SynthFrame& out);
+  [[nodiscard]] SynthFrame render(int frame);
+
+  // Pose and joints only (no image): cheap.
+  [[nodiscard]] HandPose pose(int frame) const;
+
+  [[nodiscard]] const SynthOptions& options() const;
+  [[nodiscard]] const CameraIntrinsics& camera() const;
+  [[nodiscard]] const SubjectScale& subject() const;
+  [[nodiscard]] const HandShape& shape() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// Debug picture of a frame: depth as gray (near = bright; 0 = black) beside the part labels in
+// colour, width 2 x image width.
+RgbImage preview_image(const SynthFrame& frame);
+
+}  // namespace handtrack::synth

@@ -1,0 +1,238 @@
+// handtrack-synth: renders a synthetic depth sequence with ground truth (SPEC.md "Sequence
+// directory"): camera.json, depth/, labels/, groundtruth.csv, joints.csv, plus poses.csv (the 26
+// pose parameters of each frame) and subject.json (the subject's scales and bone lengths).
+
+#include "handtrack/core/sequence.hpp"
+#include "handtrack/synth/synthetic_camera.hpp"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+
+namespace fs = std::filesystem;
+using handtrack::synth::SynthOptions;
+
+namespace {
+
+constexpr const char* kProgram = "handtrack-synth";
+
+int fail(const std::string& message, int code = 2) {
+  std::cerr << kProgram << ": error: " << message << "\n";
+  return code;
+}
+
+// "L,W" -> SubjectScale; throws std::invalid_argument.
+handtrack::synth::SubjectScale parse_subject(const std::string& text) {
+  const auto comma = text.find(',');
+  if (comma == std::string::npos) throw std::invalid_argument("--subject-scale wants L,W (e.g. 1.05,0.95)");
+  handtrack::synth::SubjectScale s;
+  try {
+    size_t used_l = 0, used_w = 0;
+    const std::string l = text.substr(0, comma), w = text.substr(comma + 1);
+    s.length = std::stod(l, &used_l);
+    s.width = std::stod(w, &used_w);
+    if (used_l != l.size() || used_w != w.size()) throw std::invalid_argument("trailing characters");
+  } catch (const std::exception&) {
+    throw std::invalid_argument("--subject-scale wants two numbers L,W, got '" + text + "'");
+  }
+  const auto ok = [](double v) { return std::isfinite(v) && v >= 0.5 && v <= 2.0; };
+  if (!ok(s.length) || !ok(s.width)) throw std::invalid_argument("--subject-scale values must be within [0.5, 2]");
+  return s;
+}
+
+// Refuses to mix a new sequence into an old one unless --force, which removes what we write.
+void prepare_output(const fs::path& dir, bool force) {
+  if (fs::exists(dir) && !fs::is_directory(dir)) throw std::runtime_error(dir.string() + " exists and is not a directory");
+  const bool has_sequence = fs::exists(dir / "camera.json") || fs::exists(dir / "depth");
+  if (!has_sequence) return;
+  if (!force) throw std::runtime_error(dir.string() + " already holds a sequence (use --force to replace it)");
+  for (const char* name : {"depth", "labels", "preview"}) fs::remove_all(dir / name);
+  for (const char* name : {"camera.json", "groundtruth.csv", "joints.csv", "poses.csv", "subject.json"}) {
+    fs::remove(dir / name);
+  }
+}
+
+void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticCamera& cam) {
+  const auto& o = cam.options();
+  nlohmann::json bones = nlohmann::json::object();
+  for (int f = 0; f < handtrack::kNumFingers; ++f) {
+    const auto& fs_ = cam.shape().fingers[static_cast<size_t>(f)];
+    bones[std::string(handtrack::kFingerNames[static_cast<size_t>(f)])] = {
+        {"bone_lengths_mm", fs_.bone_length_mm}, {"radii_mm", fs_.radius_mm},
+        {"base_mm", {fs_.base_mm.x(), fs_.base_mm.y(), fs_.base_mm.z()}}};
+  }
+  nlohmann::json j = {{"generator", kProgram},
+                      {"motion", o.motion},
+                      {"frames", o.frames},
+                      {"seed", o.seed},
+                      {"length_scale", cam.subject().length},
+                      {"width_scale", cam.subject().width},
+                      {"noise", o.noise},
+                      {"noise_sigma_k_per_mm", o.noise_params.sigma_k_per_mm},
+                      {"background", std::string(handtrack::synth::background_name(o.background))},
+                      {"fingers", bones},
+                      {"pose_parameters", "poses.csv: frame, t_x,t_y,t_z (mm, wrist), r_x,r_y,r_z (axis-angle, "
+                                          "R = exp(r) diag(1,-1,-1)), thumb..little abd,flex1,flex2,flex3 (rad)"}};
+  std::ofstream out(file);
+  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  out << j.dump(1) << "\n";
+}
+
+class PosesCsv {
+ public:
+  explicit PosesCsv(const fs::path& file) : file_(file), out_(file) {
+    if (!out_) throw std::runtime_error(file.string() + ": cannot write");
+    out_ << "frame,tx,ty,tz,rx,ry,rz";
+    for (auto name : handtrack::kFingerNames) {
+      for (const char* q : {"_abd", "_flex1", "_flex2", "_flex3"}) out_ << "," << name << q;
+    }
+    out_ << "\n";
+  }
+  void write(int frame, const handtrack::synth::HandPose& pose) {
+    const auto p = pose.to_params();
+    char buf[32];
+    out_ << frame;
+    for (int i = 0; i < p.size(); ++i) {
+      std::snprintf(buf, sizeof buf, ",%.6f", p(i));
+      out_ << buf;
+    }
+    out_ << "\n";
+    if (!out_) throw std::runtime_error(file_.string() + ": write failed");
+  }
+
+ private:
+  fs::path file_;
+  std::ofstream out_;
+};
+
+class Progress {
+ public:
+  explicit Progress(int total) : total_(total), enabled_(isatty(STDERR_FILENO) != 0), start_(Clock::now()) {}
+  void update(int done) {
+    if (!enabled_) return;
+    const auto now = Clock::now();
+    if (done < total_ && now - last_ < std::chrono::milliseconds(200)) return;
+    last_ = now;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const double eta = done > 0 ? elapsed / done * (total_ - done) : 0.0;
+    std::fprintf(stderr, "\r%s: frame %d/%d (%3.0f%%), %.1f s left   ", kProgram, done, total_,
+                 100.0 * done / total_, eta);
+    if (done == total_) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  int total_;
+  bool enabled_;
+  Clock::time_point start_;
+  Clock::time_point last_{};
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Render a synthetic depth sequence of a capsule hand performing one of the Dexter 1 motions, with "
+               "ground truth (fingertips, 21 joints, part labels) in the sequence-directory format of SPEC.md.",
+               kProgram};
+  SynthOptions options;
+  std::string motion;
+  std::string out_dir;
+  std::string subject;
+  std::string background = "body";
+  int frames = 300;
+  int width = 320;
+  int height = 240;
+  bool list = false;
+  bool force = false;
+  bool preview = false;
+  bool no_labels = false;
+  app.add_flag("--list-motions", list, "List the motions and exit");
+  app.add_option("--motion", motion, "Motion: adbadd, fingercount, fingerwave, flexex1, pinch, random, tigergrasp");
+  app.add_option("--frames", frames, "Number of frames (slow first half, fast second half)")
+      ->check(CLI::Range(1, 1000000));
+  app.add_option("--out", out_dir, "Output sequence directory");
+  app.add_option("--seed", options.seed, "Seed for the subject (unless --subject-scale) and the noise");
+  app.add_option("--subject-scale", subject, "Subject scales L,W (length, width; 1 = mean adult; default: drawn "
+                                             "from the seed within +-10%)");
+  app.add_flag("--noise,!--no-noise", options.noise, "Sensor noise model on (default) or off");
+  app.add_option("--background", background, "Background: body (default), table or none");
+  app.add_option("--width", width, "Image width (intrinsics scale with it)")->check(CLI::Range(16, 4096));
+  app.add_option("--height", height, "Image height (intrinsics scale with it)")->check(CLI::Range(16, 4096));
+  app.add_flag("--preview", preview, "Also write preview/NNNNNN.png (depth gray | labels in colour)");
+  app.add_flag("--no-labels", no_labels, "Do not write labels/");
+  app.add_flag("--force", force, "Replace a sequence already in --out");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::string what = e.what();
+    for (auto& c : what) {
+      if (c == '\n') c = ' ';
+    }
+    return fail(what + " (see --help)");
+  }
+
+  if (list) {
+    for (auto name : handtrack::synth::kMotionNames) {
+      std::cout << name << "\t" << handtrack::synth::motion_description(name) << "\n";
+    }
+    return 0;
+  }
+  if (motion.empty()) return fail("--motion is required (see --list-motions)");
+  if (out_dir.empty()) return fail("--out is required");
+  if (handtrack::synth::motion_description(motion).empty()) {
+    return fail("unknown motion '" + motion + "' (see --list-motions)");
+  }
+  const auto bg = handtrack::synth::parse_background(background);
+  if (!bg) return fail("--background must be body, table or none, got '" + background + "'");
+
+  try {
+    options.motion = motion;
+    options.frames = frames;
+    options.background = *bg;
+    options.camera = handtrack::synth::default_camera(width, height);
+    if (!subject.empty()) options.subject = parse_subject(subject);
+    handtrack::synth::SyntheticCamera cam(options);
+
+    const fs::path dir(out_dir);
+    prepare_output(dir, force);
+    handtrack::SequenceWriter writer(dir, cam.camera());
+    write_subject_json(dir / "subject.json", cam);
+    PosesCsv poses(dir / "poses.csv");
+    if (preview) fs::create_directories(dir / "preview");
+
+    Progress progress(frames);
+    handtrack::synth::SynthFrame frame;
+    for (int i = 0; i < frames; ++i) {
+      cam.render(i, frame);
+      writer.write_depth(i, frame.depth);
+      if (!no_labels) writer.write_labels(i, frame.labels);
+      writer.write_fingertips(i, frame.fingertips);
+      writer.write_joints(i, frame.joints);
+      poses.write(i, frame.pose);
+      if (preview) handtrack::write_png_rgb(handtrack::frame_file(dir / "preview", i), preview_image(frame));
+      progress.update(i + 1);
+    }
+    writer.flush();
+  } catch (const std::invalid_argument& e) {
+    return fail(e.what());
+  } catch (const std::exception& e) {
+    return fail(e.what(), 1);
+  }
+  return 0;
+}

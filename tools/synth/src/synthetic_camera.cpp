@@ -1,0 +1,273 @@
+#include "handtrack/synth/synthetic_camera.hpp"
+
+#include "raycaster.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+namespace handtrack::synth {
+namespace {
+
+using Eigen::Vector3d;
+
+// Random streams (Rng::stream purposes), so that changing one use never shifts another.
+constexpr uint64_t kSubjectStream = 0x5B1EC7;
+constexpr uint64_t kNoiseStream = 0x0015E;
+constexpr double kSubjectSpread = 0.10;  // random subjects: scales within +-10 % (module brief)
+
+// SPEC.md's example camera (a Senz3D-like 320x240 sensor).
+constexpr double kSpecFx = 224.502;
+constexpr double kSpecFy = 230.494;
+constexpr double kSpecWidth = 320.0;
+constexpr double kSpecHeight = 240.0;
+constexpr double kSpecFps = 60.0;
+
+PlanePatch make_patch(const Vector3d& origin, const Vector3d& normal, double half_u, double half_v) {
+  PlanePatch p;
+  p.origin = origin;
+  p.normal = normal.normalized();
+  p.axis_u = Vector3d::UnitY().cross(p.normal).normalized();
+  p.axis_v = p.normal.cross(p.axis_u).normalized();
+  p.half_u = half_u;
+  p.half_v = half_v;
+  p.label = kBackground;
+  return p;
+}
+
+}  // namespace
+
+std::string_view background_name(Background background) {
+  switch (background) {
+    case Background::kNone:
+      return "none";
+    case Background::kBody:
+      return "body";
+    case Background::kTable:
+      return "table";
+  }
+  return "none";
+}
+
+std::optional<Background> parse_background(std::string_view name) {
+  for (auto b : {Background::kNone, Background::kBody, Background::kTable}) {
+    if (background_name(b) == name) return b;
+  }
+  return std::nullopt;
+}
+
+CameraIntrinsics default_camera(int width, int height) {
+  CameraIntrinsics c;
+  c.width = width;
+  c.height = height;
+  c.fx = kSpecFx * width / kSpecWidth;
+  c.fy = kSpecFy * height / kSpecHeight;
+  c.cx = 0.5 * width;
+  c.cy = 0.5 * height;
+  c.depth_scale_mm = 1.0;
+  c.fps = kSpecFps;
+  return c;
+}
+
+struct SyntheticCamera::State {
+  SynthOptions options;
+  HandShape shape;
+  Motion motion;
+  Raycaster raycaster;
+  std::vector<ConeSphere> primitives;
+  std::vector<PlanePatch> planes;
+  std::vector<ConeSphere> background_solids;
+
+  State(SynthOptions o, const HandShape& s)
+      : options(std::move(o)), shape(s), motion(options.motion, options.frames, options.camera.fps, shape),
+        raycaster(options.camera) {}
+
+  void apply_noise(int frame, SynthFrame& out) const;
+};
+
+SyntheticCamera::SyntheticCamera(SynthOptions options) {
+  if (auto why = options.camera.problem(); !why.empty()) throw std::invalid_argument("camera: " + why);
+  SubjectScale subject;
+  if (options.subject) {
+    subject = *options.subject;
+    const auto ok = [](double s) { return std::isfinite(s) && s >= 0.5 && s <= 2.0; };
+    if (!ok(subject.length) || !ok(subject.width)) {
+      throw std::invalid_argument("subject scale must be within [0.5, 2], got " + std::to_string(subject.length) +
+                                  "," + std::to_string(subject.width));
+    }
+  } else {
+    Rng rng = Rng::stream(options.seed, kSubjectStream);
+    subject.length = rng.uniform(1.0 - kSubjectSpread, 1.0 + kSubjectSpread);
+    subject.width = rng.uniform(1.0 - kSubjectSpread, 1.0 + kSubjectSpread);
+    options.subject = subject;
+  }
+  state_ = std::make_unique<State>(std::move(options), HandShape::for_subject(subject));
+  State& s = *state_;
+  switch (s.options.background) {
+    case Background::kNone:
+      break;
+    case Background::kBody:
+      // Torso: a 440 x 800 mm patch facing the camera, 700-850 mm away (beyond the tracker's
+      // 150-600 mm working volume), slightly turned; neck and head above it.
+      s.planes.push_back(make_patch({30, 250, 780}, {0.15, -0.08, -1.0}, 220.0, 400.0));
+      s.background_solids.push_back(ConeSphere{{30, -150, 790}, {30, -200, 800}, 55.0, 55.0, kBackground});
+      s.background_solids.push_back(ConeSphere{{30, -270, 810}, {30, -270, 810}, 95.0, 95.0, kBackground});
+      break;
+    case Background::kTable:
+      // A table top through (0, 250, 750) mm rising away from the camera (normal up and toward the
+      // camera): at the bottom of the image ~610 mm, crossing the image centre at ~1 m.
+      s.planes.push_back(make_patch({0, 250, 750}, {0.0, -1.0, -0.5}, 0.0, 0.0));
+      break;
+  }
+}
+
+SyntheticCamera::~SyntheticCamera() = default;
+SyntheticCamera::SyntheticCamera(SyntheticCamera&&) noexcept = default;
+SyntheticCamera& SyntheticCamera::operator=(SyntheticCamera&&) noexcept = default;
+
+const SynthOptions& SyntheticCamera::options() const { return state_->options; }
+const CameraIntrinsics& SyntheticCamera::camera() const { return state_->options.camera; }
+const SubjectScale& SyntheticCamera::subject() const { return state_->shape.subject; }
+const HandShape& SyntheticCamera::shape() const { return state_->shape; }
+
+HandPose SyntheticCamera::pose(int frame) const { return state_->motion.pose(frame); }
+
+SynthFrame SyntheticCamera::render(int frame) {
+  SynthFrame out;
+  render(frame, out);
+  return out;
+}
+
+void SyntheticCamera::render(int frame, SynthFrame& out) {
+  State& s = *state_;
+  const CameraIntrinsics& cam = s.options.camera;
+  out.frame = frame;
+  out.pose = s.motion.pose(frame);
+  out.joints = camera_frame_joints(s.shape, out.pose);
+  out.fingertips = fingertips_from_joints(out.joints);
+
+  posed_primitives(s.shape, out.pose, out.joints, s.primitives);
+  s.raycaster.clear();
+  // Near things first so that early z rejection skips most of the far ones.
+  for (const auto& p : s.primitives) s.raycaster.draw(p);
+  for (const auto& p : s.background_solids) s.raycaster.draw(p);
+  for (const auto& p : s.planes) s.raycaster.draw(p);
+
+  const size_t n = static_cast<size_t>(cam.width) * static_cast<size_t>(cam.height);
+  out.depth.camera = cam;
+  out.depth.depth_mm.resize(n);
+  out.labels.width = cam.width;
+  out.labels.height = cam.height;
+  out.labels.channels = 1;
+  out.labels.pixels.resize(n);
+  if (s.options.noise) {
+    s.apply_noise(frame, out);
+  } else {
+    const auto& clean = s.raycaster.depth_mm();
+    const auto& labels = s.raycaster.labels();
+    const auto lo = static_cast<float>(s.options.noise_params.min_range_mm);
+    const auto hi = static_cast<float>(s.options.noise_params.max_range_mm);
+    for (size_t i = 0; i < n; ++i) {
+      const float z = clean[i];
+      const bool valid = z >= lo && z <= hi;
+      out.depth.depth_mm[i] = valid ? z : 0.0f;
+      out.labels.pixels[i] = valid ? labels[i] : uint8_t{0};
+    }
+  }
+}
+
+void SyntheticCamera::State::apply_noise(int frame, SynthFrame& out) const {
+  const NoiseParams& np = options.noise_params;
+  const int w = options.camera.width;
+  const int h = options.camera.height;
+  const auto& clean = raycaster.depth_mm();
+  const auto& labels = raycaster.labels();
+  const auto& incidence = raycaster.incidence_cos();
+  Rng rng = Rng::stream(options.seed, kNoiseStream, static_cast<uint64_t>(frame));
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const size_t i = static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u);
+      double z = clean[i];
+      out.depth.depth_mm[i] = 0.0f;
+      out.labels.pixels[i] = 0;
+      if (!std::isfinite(z)) continue;
+      // Flying pixels: the neighbour across the largest depth jump (no surface = +inf depth, an
+      // infinite jump).
+      double jump = 0.0;
+      double neighbour = z;
+      const auto consider = [&](size_t k) {
+        const double zn = clean[k];
+        const double d = std::abs(zn - z);
+        if (d > jump) {
+          jump = d;
+          neighbour = zn;
+        }
+      };
+      if (u > 0) consider(i - 1);
+      if (u + 1 < w) consider(i + 1);
+      if (v > 0) consider(i - static_cast<size_t>(w));
+      if (v + 1 < h) consider(i + static_cast<size_t>(w));
+      if (jump > np.edge_threshold_mm && rng.uniform() < np.flying_pixel_probability) {
+        if (!std::isfinite(neighbour)) continue;  // dropped
+        z += rng.uniform(0.1, 0.9) * (neighbour - z);
+      }
+      // Dropouts: anywhere, and increasingly at grazing incidence.
+      if (rng.uniform() < np.dropout_probability) continue;
+      const double grazing = np.grazing_dropout_max * std::clamp(1.0 - incidence[i] / np.grazing_cos, 0.0, 1.0);
+      if (grazing > 0.0 && rng.uniform() < grazing) continue;
+      // sigma(z) = k z^2, then quantisation.
+      z += np.sigma_mm(z) * rng.fast_normal();
+      if (np.quantization_mm > 0.0 && z > 0.0) {
+        // Round half up (z > 0); a cast instead of std::round keeps this inline in the pixel loop.
+        z = static_cast<double>(static_cast<int64_t>(z / np.quantization_mm + 0.5)) * np.quantization_mm;
+      }
+      if (z < np.min_range_mm || z > np.max_range_mm) continue;
+      out.depth.depth_mm[i] = static_cast<float>(z);
+      out.labels.pixels[i] = labels[i];
+    }
+  }
+}
+
+RgbImage preview_image(const SynthFrame& frame) {
+  static constexpr std::array<std::array<uint8_t, 3>, kNumPartLabels + 1> kPalette = {{
+      {0, 0, 0},        // background
+      {200, 200, 200},  // palm
+      {255, 60, 60},    {200, 0, 0},     {120, 0, 0},    // thumb
+      {255, 170, 0},    {170, 100, 0},                   // index
+      {240, 240, 0},    {140, 140, 0},                   // middle
+      {0, 220, 80},     {0, 120, 40},                    // ring
+      {60, 140, 255},   {0, 50, 170},                    // little
+  }};
+  const int w = frame.depth.width();
+  const int h = frame.depth.height();
+  RgbImage img;
+  img.width = 2 * w;
+  img.height = h;
+  img.channels = 3;
+  img.pixels.assign(static_cast<size_t>(img.width) * static_cast<size_t>(h) * 3, 0);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const float z = frame.depth.at(u, v);
+      const size_t left = (static_cast<size_t>(v) * static_cast<size_t>(img.width) + static_cast<size_t>(u)) * 3;
+      const size_t right = left + static_cast<size_t>(w) * 3;
+      // Near (250 mm) bright, far (1000 mm) dark; no measurement black.
+      const auto g = z > 0 ? static_cast<uint8_t>(std::clamp(255.0 - (z - 250.0) * (215.0 / 750.0), 40.0, 255.0))
+                           : uint8_t{0};
+      img.pixels[left] = img.pixels[left + 1] = img.pixels[left + 2] = g;
+      const int label = frame.labels.pixels[static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u)];
+      const auto& c = kPalette[static_cast<size_t>(std::clamp(label, 0, kNumPartLabels))];
+      if (label == 0 && z > 0) {
+        img.pixels[right] = img.pixels[right + 1] = img.pixels[right + 2] = static_cast<uint8_t>(g / 3);
+      } else {
+        img.pixels[right] = c[0];
+        img.pixels[right + 1] = c[1];
+        img.pixels[right + 2] = c[2];
+      }
+    }
+  }
+  return img;
+}
+
+}  // namespace handtrack::synth
