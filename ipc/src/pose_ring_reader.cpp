@@ -193,8 +193,9 @@ Status PoseRingReader::writer_trouble(std::int64_t now_ns) const noexcept {
       static_cast<std::uint32_t>(DeviceState::kStopped)) {
     return HANDTRACK_ERR_WRITER_STOPPED;
   }
-  const std::int64_t age = now_ns - header_->heartbeat_ns.load(std::memory_order_relaxed);
-  if (2 * age > shm::kDeadAfterHalfPeriods * header_->heartbeat_period_ns) {
+  const std::int64_t age =
+      detail::heartbeat_age_ns(now_ns, header_->heartbeat_ns.load(std::memory_order_relaxed));
+  if (age > detail::dead_after_ns(header_->heartbeat_period_ns, shm::kDeadAfterHalfPeriods)) {
     return HANDTRACK_ERR_WRITER_DEAD;
   }
   return HANDTRACK_OK;
@@ -213,7 +214,9 @@ Status PoseRingReader::wait(PoseRecord& out, std::chrono::nanoseconds timeout,
                             Mode mode) noexcept {
   if (header_ == nullptr) return HANDTRACK_ERR_INVALID_ARGUMENT;
   const std::int64_t start = detail::monotonic_ns();
-  const std::int64_t deadline = start + std::max<std::int64_t>(timeout.count(), 0);
+  // Timeouts beyond ~290 years are "forever" (and must not overflow the deadline).
+  const std::int64_t deadline =
+      start + std::clamp<std::int64_t>(timeout.count(), 0, std::int64_t{1} << 62);
   std::int64_t last_reattach_ns = start - header_->heartbeat_period_ns;
   for (;;) {
     // SYNC: acquire; pairs with the writer's release RMW on the word after each publish and state
@@ -257,9 +260,11 @@ Status PoseRingReader::wait(PoseRecord& out, std::chrono::nanoseconds timeout,
     const std::int64_t period = header_->heartbeat_period_ns;
     if (trouble == HANDTRACK_OK) {
       // Wake when the heartbeat would turn stale, to report a dead writer on time.
-      const std::int64_t stale_at = header_->heartbeat_ns.load(std::memory_order_relaxed) +
-                                    shm::kDeadAfterHalfPeriods * period / 2 + 1'000'000;
-      sleep_ns = std::min(sleep_ns, std::max<std::int64_t>(stale_at - now, 1'000'000));
+      const std::int64_t age =
+          detail::heartbeat_age_ns(now, header_->heartbeat_ns.load(std::memory_order_relaxed));
+      const std::int64_t until_stale =
+          detail::dead_after_ns(period, shm::kDeadAfterHalfPeriods) + 1'000'000 - age;
+      sleep_ns = std::min(sleep_ns, std::max<std::int64_t>(until_stale, 1'000'000));
     } else {
       sleep_ns = std::min(sleep_ns, period / 2);  // poll the name for a new writer
     }
@@ -288,7 +293,7 @@ Status PoseRingReader::writer_status(WriterStatus& out) noexcept {
   out.epoch = header_->epoch;
   out.records_published = header_->head.load(std::memory_order_acquire);
   out.heartbeat_ns = header_->heartbeat_ns.load(std::memory_order_relaxed);
-  out.heartbeat_age_ns = now - out.heartbeat_ns;
+  out.heartbeat_age_ns = detail::heartbeat_age_ns(now, out.heartbeat_ns);
   out.heartbeat_period_ns = header_->heartbeat_period_ns;
   for (int attempt = 0; attempt < kReadAttempts; ++attempt) {
     // The stats seqlock: same protocol as a slot; the version we want is whatever is current.

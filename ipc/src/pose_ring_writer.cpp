@@ -77,8 +77,9 @@ Previous inspect_previous(const std::string& name) {
   prev.pid = h->writer_pid;
   // SYNC: relaxed loads: a liveness estimate, guarding no data.
   const auto state = static_cast<DeviceState>(h->device_state.load(std::memory_order_relaxed));
-  const std::int64_t age = detail::monotonic_ns() - h->heartbeat_ns.load(std::memory_order_relaxed);
-  const bool fresh = 2 * age <= shm::kDeadAfterHalfPeriods * h->heartbeat_period_ns;
+  const std::int64_t age = detail::heartbeat_age_ns(
+      detail::monotonic_ns(), h->heartbeat_ns.load(std::memory_order_relaxed));
+  const bool fresh = age <= detail::dead_after_ns(h->heartbeat_period_ns, shm::kDeadAfterHalfPeriods);
   prev.live = state != DeviceState::kStopped && fresh && pid_exists(prev.pid);
   return prev;
 }

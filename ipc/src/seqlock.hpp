@@ -46,6 +46,21 @@ inline std::int64_t realtime_us() noexcept {
   return std::int64_t{ts.tv_sec} * 1'000'000 + ts.tv_nsec / 1000;
 }
 
+// now - heartbeat, saturated to +-2^62 so that arithmetic on a garbage heartbeat (a corrupt or
+// hostile segment) cannot overflow.
+inline std::int64_t heartbeat_age_ns(std::int64_t now_ns, std::int64_t heartbeat_ns) noexcept {
+  constexpr std::int64_t kLimit = std::int64_t{1} << 62;
+  std::int64_t age = 0;
+  if (__builtin_sub_overflow(now_ns, heartbeat_ns, &age)) return heartbeat_ns > now_ns ? -kLimit : kLimit;
+  return age < -kLimit ? -kLimit : (age > kLimit ? kLimit : age);
+}
+
+// The age after which a writer counts as dead: 2.5 heartbeat periods (kDeadAfterHalfPeriods / 2).
+// `period_ns` is at most kMaxHeartbeatPeriodNs (validated), so this cannot overflow.
+inline std::int64_t dead_after_ns(std::int64_t period_ns, std::int64_t half_periods) noexcept {
+  return half_periods * period_ns / 2;
+}
+
 // --- writer side ----------------------------------------------------------------------------
 
 inline void seqlock_begin_write(std::atomic<std::uint64_t>& seq, std::uint64_t odd) noexcept {
