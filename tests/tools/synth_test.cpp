@@ -161,7 +161,10 @@ TEST(SynthNoise, DepthNoiseFollowsTheModelAndEdgesFlyAndDropouts) {
           max_jump = std::max(max_jump, zn > 0 ? std::abs(zn - z) : 1e9f);
         }
         const float zn = n.depth.at(u, v);
-        if (max_jump > 50 && zn > 0 && std::abs(zn - z) > 10 && std::abs(zn - z) < max_jump) ++flying;
+        if (max_jump > 50 && zn > 0 && std::abs(zn - z) > std::max(10.0, 5.0 * np.sigma_mm(z)) &&
+            std::abs(zn - z) < max_jump) {
+          ++flying;
+        }
         if (max_jump > 3) continue;  // interior pixels only below
         ++interior;
         if (zn == 0) {
@@ -192,6 +195,19 @@ TEST(SynthNoise, DepthNoiseFollowsTheModelAndEdgesFlyAndDropouts) {
   EXPECT_GT(drop_rate, 0.5 * np.dropout_probability);
   EXPECT_LT(drop_rate, 0.05);
   EXPECT_GT(flying, 100u) << "no flying pixels at depth edges";
+
+  // The same count without flying pixels is near zero: the count above measures the effect.
+  o.noise_params.flying_pixel_probability = 0.0;
+  SyntheticCamera steady(o);
+  size_t off_edge = 0;
+  for (int i = 0; i < 300; i += 20) {
+    const SynthFrame c = clean.render(i), n = steady.render(i);
+    for (size_t k = 0; k < c.depth.depth_mm.size(); ++k) {
+      const float z = c.depth.depth_mm[k], zn = n.depth.depth_mm[k];
+      off_edge += (z > 0 && zn > 0 && std::abs(zn - z) > std::max(10.0, 5.0 * np.sigma_mm(z))) ? 1 : 0;
+    }
+  }
+  EXPECT_LT(off_edge, 10u);
 }
 
 TEST(SynthNoise, QuantisedAndWithinRange) {

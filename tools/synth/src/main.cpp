@@ -26,7 +26,7 @@ namespace {
 
 constexpr const char* kProgram = "handtrack-synth";
 
-int fail(const std::string& message, int code = 2) {
+int fail(const std::string& message, int code = 1) {
   std::cerr << kProgram << ": error: " << message << "\n";
   return code;
 }
@@ -232,7 +232,7 @@ int main(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     return fail(e.what());
   } catch (const std::exception& e) {
-    return fail(e.what(), 1);
+    return fail(e.what());
   }
   return 0;
 }
