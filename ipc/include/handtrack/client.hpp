@@ -1,10 +1,17 @@
 // handtrack/client.hpp: a header-only C++ RAII wrapper over the stable C API (handtrack/client.h).
 // Links against the C library (handtrack::client), so applications get its ABI stability.
 //
-//   handtrack::Client client;                       // not connected yet
-//   if (auto st = client.open("handtrack"); st != HANDTRACK_OK) { ... handtrack::Client::describe(st) ... }
+//   handtrack::Client client;
+//   if (int st = client.open("handtrack"); st != HANDTRACK_OK) {
+//     std::cerr << handtrack::Client::describe(st) << "\n";   // e.g. "no handtrack shared memory..."
+//     return 1;
+//   }
 //   handtrack_pose pose;
-//   while (client.wait_next(pose, std::chrono::seconds(1)) != HANDTRACK_ERR_INVALID_ARGUMENT) { ... }
+//   for (;;) {
+//     int st = client.wait_next(pose, std::chrono::seconds(1));
+//     if (st == HANDTRACK_OK) use(pose, client.missed());
+//     // HANDTRACK_TIMEOUT, _ERR_WRITER_DEAD, _ERR_WRITER_STOPPED: keep waiting; it reattaches itself
+//   }
 //
 // Status values, not exceptions: reading poses is a hot path (STYLE: "the ipc reader returns
 // status values and never throws"). One Client belongs to one thread at a time.
