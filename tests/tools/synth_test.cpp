@@ -98,7 +98,7 @@ TEST(SynthCamera, BoneLengthsArePreservedAndFollowTheSubjectScale) {
         }
         // The base joints are rigid in the hand frame: their distance to the wrist is fixed.
         const Eigen::Vector3d b = mean.fingers[static_cast<size_t>(f)].base_mm;
-        const Eigen::Vector3d scaled(0.93 * b.x(), 1.07 * b.y(), 0.93 * b.z());
+        const Eigen::Vector3d scaled(0.93 * b.x(), 1.07 * b.y(), b.z());
         EXPECT_NEAR((j[static_cast<size_t>(handtrack::joint_index(f, 0))] - j[0]).norm(), scaled.norm(), 1e-6);
       }
     }
@@ -393,6 +393,38 @@ TEST(SynthCamera, RejectsBadOptions) {
   o = SynthOptions{};
   o.subject = SubjectScale{3.0, 1.0};
   EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
+}
+
+}  // namespace
+
+// The generator and the tracker implement the same skeleton separately (module brief); at random
+// poses within the limits, both must put all 21 joints of the mean adult hand at the same place.
+#include "handtrack/core/kinematics.hpp"
+
+namespace {
+
+TEST(SynthKinematics, AgreesWithTheTrackersSkeleton) {
+  const JointLimits limits = JointLimits::defaults();
+  Rng rng(11);
+  for (int trial = 0; trial < 60; ++trial) {
+    // A third of the trials with a scaled subject: both sides scale lengths by `length` and base
+    // offsets across the hand by `width`.
+    const SubjectScale subject = trial % 3 == 0 ? SubjectScale{} : SubjectScale{rng.uniform(0.9, 1.1), rng.uniform(0.9, 1.1)};
+    const handtrack::HandModel model = handtrack::HandModel::default_adult({subject.length, subject.width, 1.0});
+    const HandShape shape = HandShape::for_subject(subject);
+    HandPose pose;
+    pose.translation_mm = Eigen::Vector3d(rng.uniform(-50, 50), rng.uniform(-50, 50), rng.uniform(300, 500));
+    pose.rotation = Eigen::Vector3d(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+    for (size_t f = 0; f < kNumFingers; ++f) {
+      for (size_t k = 0; k < 4; ++k) pose.fingers[f][k] = rng.uniform(limits.lower[f][k], limits.upper[f][k]);
+    }
+    const Joints ours = camera_frame_joints(shape, pose);
+    const handtrack::PosedHand theirs(model, pose.to_params());
+    for (int j = 0; j < handtrack::kNumJoints; ++j) {
+      EXPECT_LT((ours[static_cast<size_t>(j)] - theirs.joints()[static_cast<size_t>(j)]).norm(), 1e-6)
+          << "joint " << handtrack::joint_name(j) << ", trial " << trial;
+    }
+  }
 }
 
 }  // namespace

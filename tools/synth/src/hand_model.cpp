@@ -124,7 +124,10 @@ HandShape HandShape::for_subject(const SubjectScale& subject) {
   const Vector3d scale(subject.width, subject.length, subject.width);
   const auto scale_point = [&](const Vector3d& p) -> Vector3d { return p.cwiseProduct(scale); };
   for (auto& f : s.fingers) {
-    f.base_mm = scale_point(f.base_mm);
+    // Joint positions scale as in the tracker's model: base x by width, y by length, z unscaled
+    // (only the thumb's base has z != 0). The solid palm below also thickens with width.
+    f.base_mm.x() *= subject.width;
+    f.base_mm.y() *= subject.length;
     for (auto& l : f.bone_length_mm) l *= subject.length;
     for (auto& r : f.radius_mm) r *= subject.width;
   }

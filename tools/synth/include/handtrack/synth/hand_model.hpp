@@ -59,7 +59,8 @@ struct JointLimits {
 };
 
 // A subject's size relative to the mean adult hand: `length` scales bone lengths and the hand
-// frame's y coordinates, `width` scales x and z coordinates (finger bases, palm) and all radii.
+// frame's y coordinates, `width` scales x coordinates and all radii. Finger bases keep their z (as
+// in the tracker's HandModel::default_adult); the palm and forearm solids scale z by `width`.
 struct SubjectScale {
   double length = 1.0;
   double width = 1.0;
