@@ -323,17 +323,23 @@ class OpenNi2Camera final : public OpenNi2SourceBase {
     };
     const openni::VideoMode* mode = find_mode(options_.width, options_.height, options_.fps);
     if (!mode) mode = find_mode(kFallbackWidth, kFallbackHeight, kFallbackFps);
-    if (mode) {
+    const openni::VideoMode current = stream_->getVideoMode();
+    const bool already = mode && current.getResolutionX() == mode->getResolutionX() &&
+                         current.getResolutionY() == mode->getResolutionY() && current.getFps() == mode->getFps() &&
+                         current.getPixelFormat() == mode->getPixelFormat();
+    // Set only what differs: OpenNI2 refuses any change (even to the same mode) while another
+    // stream on the same sensor runs.
+    if (mode && !already) {
       if (stream_->setVideoMode(*mode) != openni::STATUS_OK) {
         *why = with_detail("cannot set depth mode " + std::to_string(mode->getResolutionX()) + "x" +
                            std::to_string(mode->getResolutionY()) + "@" + std::to_string(mode->getFps()));
         return false;
       }
-    } else {
+    } else if (!mode) {
       logger()->warn("{}: neither {}x{}@{} nor {}x{}@{} is offered; keeping the sensor's mode", describe(),
                      options_.width, options_.height, options_.fps, kFallbackWidth, kFallbackHeight, kFallbackFps);
     }
-    if (stream_->isPropertySupported(openni::STREAM_PROPERTY_MIRRORING) &&
+    if (stream_->isPropertySupported(openni::STREAM_PROPERTY_MIRRORING) && stream_->getMirroringEnabled() &&
         stream_->setMirroringEnabled(false) != openni::STATUS_OK) {
       logger()->warn("{}: cannot turn mirroring off", describe());
     }
