@@ -58,11 +58,13 @@ int scaled_px(int px_at_320, int width) { return std::max(1, px_at_320 * std::ma
 DepthInputBuilder::DepthInputBuilder(DepthInputConfig config) : config_(config) {}
 
 const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::optional<HandHint>& hint,
-                                           const uint8_t* labels) {
+                                           const PixelLabeller* labeller) {
   out_.camera = depth.camera;
   median_filter(depth);
   segment(hint);
-  build_quadtree(labels);
+  out_.pixel_labels.clear();
+  if (labeller != nullptr && out_.hand_pixels > 0) labeller->label(out_, out_.pixel_labels);
+  build_quadtree();
   out_.self_similarity = image_self_similarity(out_.gaussians);
   return out_;
 }
@@ -269,7 +271,7 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
   }
 }
 
-void DepthInputBuilder::build_quadtree(const uint8_t* labels) {
+void DepthInputBuilder::build_quadtree() {
   out_.gaussians.clear();
   if (out_.hand_pixels == 0) return;
   const int w = out_.camera.width;
@@ -291,11 +293,11 @@ void DepthInputBuilder::build_quadtree(const uint8_t* labels) {
     }
   }
   for (int y = (v0 / root) * root; y <= v1; y += root) {
-    for (int x = (u0 / root) * root; x <= u1; x += root) quad(x, y, root, min_leaf, labels);
+    for (int x = (u0 / root) * root; x <= u1; x += root) quad(x, y, root, min_leaf);
   }
 }
 
-void DepthInputBuilder::quad(int x, int y, int side, int min_leaf, const uint8_t* labels) {
+void DepthInputBuilder::quad(int x, int y, int side, int min_leaf) {
   const int w = out_.camera.width;
   const int h = out_.camera.height;
   const int xe = std::min(x + side, w);
@@ -321,10 +323,10 @@ void DepthInputBuilder::quad(int x, int y, int side, int min_leaf, const uint8_t
   const bool flat = hi - lo < config_.quadtree_threshold_mm;
   if (side > min_leaf && !(flat && full_enough)) {
     const int half = side / 2;
-    quad(x, y, half, min_leaf, labels);
-    quad(x + half, y, half, min_leaf, labels);
-    quad(x, y + half, half, min_leaf, labels);
-    quad(x + half, y + half, half, min_leaf, labels);
+    quad(x, y, half, min_leaf);
+    quad(x + half, y, half, min_leaf);
+    quad(x, y + half, half, min_leaf);
+    quad(x + half, y + half, half, min_leaf);
     return;
   }
   if (!full_enough) return;
@@ -334,7 +336,8 @@ void DepthInputBuilder::quad(int x, int y, int side, int min_leaf, const uint8_t
   g.sigma_px = side / std::sqrt(2.0);  // Sec. 3.1: sigma = a / sqrt(2)
   g.depth_mm = sum / count;
   g.side_px = side;
-  if (labels != nullptr) {
+  const auto& labels = out_.pixel_labels;
+  if (!labels.empty()) {
     std::array<int, kNumPartLabels + 1> votes{};
     for (int v = y; v < ye; ++v) {
       for (int u = x; u < xe; ++u) {
@@ -346,6 +349,12 @@ void DepthInputBuilder::quad(int x, int y, int side, int min_leaf, const uint8_t
     if (votes[static_cast<size_t>(g.label)] == 0) g.label = 0;
   }
   out_.gaussians.push_back(g);
+}
+
+void FixedLabels::label(const DepthInput& input, std::vector<uint8_t>& labels) const {
+  labels.assign(input.hand_mask.size(), 0);
+  if (labels_ == nullptr || labels_->size() != labels.size()) return;
+  for (size_t i = 0; i < labels.size(); ++i) labels[i] = input.hand_mask[i] ? (*labels_)[i] : uint8_t{0};
 }
 
 double image_self_similarity(const std::vector<ImageGaussian>& gaussians) {

@@ -49,6 +49,7 @@ struct DepthInput {
   CameraIntrinsics camera;
   std::vector<float> filtered_mm;     // median-filtered depth, 0 outside the working volume
   std::vector<uint8_t> hand_mask;     // 1 = pixel belongs to the segmented hand
+  std::vector<uint8_t> pixel_labels;  // part label per pixel (0 = none); empty without a labeller
   std::vector<ImageGaussian> gaussians;
   double self_similarity = 0.0;       // E(C_I, C_I), normalises E_sim (Sec. 4.1)
   int hand_pixels = 0;
@@ -58,22 +59,42 @@ struct DepthInput {
   [[nodiscard]] bool has_hand() const { return !gaussians.empty(); }
 };
 
+// Gives the segmented hand's pixels part labels (Sec. 4.3): the decision forest, or in tests the
+// ground-truth label image.
+class PixelLabeller {
+ public:
+  virtual ~PixelLabeller() = default;
+  // Fills `labels` (resized to the image) for the pixels where input.hand_mask is set; others 0.
+  // Reads input.filtered_mm, input.hand_mask and input.camera.
+  virtual void label(const DepthInput& input, std::vector<uint8_t>& labels) const = 0;
+};
+
+// A PixelLabeller that copies a given label image (ground truth), for tests and ablations.
+class FixedLabels final : public PixelLabeller {
+ public:
+  explicit FixedLabels(const std::vector<uint8_t>* labels) : labels_(labels) {}
+  void label(const DepthInput& input, std::vector<uint8_t>& labels) const override;
+
+ private:
+  const std::vector<uint8_t>* labels_;
+};
+
 class DepthInputBuilder {
  public:
   explicit DepthInputBuilder(DepthInputConfig config = {});
 
-  // Builds C_I for one frame. `labels` (optional, same size as the image) gives per-pixel part
-  // labels from the forest. Storage is reused between calls.
+  // Builds C_I for one frame. With a `labeller`, the hand's pixels get part labels and each
+  // quadtree leaf the majority label of its pixels (Sec. 4.3). Storage is reused between calls.
   const DepthInput& build(const DepthImage& depth, const std::optional<HandHint>& hint,
-                          const uint8_t* labels = nullptr);
+                          const PixelLabeller* labeller = nullptr);
   [[nodiscard]] const DepthInput& last() const { return out_; }
   [[nodiscard]] const DepthInputConfig& config() const { return config_; }
 
  private:
   void median_filter(const DepthImage& depth);
   void segment(const std::optional<HandHint>& hint);
-  void build_quadtree(const uint8_t* labels);
-  void quad(int x, int y, int side, int min_leaf, const uint8_t* labels);
+  void build_quadtree();
+  void quad(int x, int y, int side, int min_leaf);
 
   DepthInputConfig config_;
   DepthInput out_;

@@ -92,8 +92,8 @@ class PoseTracker {
 class Tracker {
  public:
   explicit Tracker(TrackerConfig config = {}) : builder_(config.input), pose_(config) {}
-  TrackerOutput track(const DepthImage& depth, const uint8_t* labels = nullptr) {
-    return pose_.optimise(builder_.build(depth, pose_.hint(), labels));
+  TrackerOutput track(const DepthImage& depth, const PixelLabeller* labeller = nullptr) {
+    return pose_.optimise(builder_.build(depth, pose_.hint(), labeller));
   }
   [[nodiscard]] const DepthInput& last_input() const { return builder_.last(); }
   [[nodiscard]] PoseTracker& pose_tracker() { return pose_; }
