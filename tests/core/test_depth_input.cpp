@@ -94,10 +94,16 @@ TEST(DepthInput, SteepSurfacesSplitFinerThanFlatOnes) {
       steep.at(u, v) = static_cast<float>(400 + 2.0 * (u - 120));  // 2 mm per pixel
     }
   }
+  // A hint that keeps both squares whole: centred on them, the wrist plane far below.
+  const HandHint hint{cam.unproject(160, 120, 480), cam.unproject(160, 400, 480), Eigen::Vector3d(0, -1, 0)};
   DepthInputBuilder a;
   DepthInputBuilder b;
-  const size_t n_flat = a.build(flat, std::nullopt).gaussians.size();
-  const size_t n_steep = b.build(steep, std::nullopt).gaussians.size();
+  const auto& in_flat = a.build(flat, hint);
+  const auto& in_steep = b.build(steep, hint);
+  EXPECT_GE(in_flat.hand_pixels, 80 * 80 - 4);  // the 3x3 median takes the four corners
+  EXPECT_GE(in_steep.hand_pixels, 80 * 80 - 4);
+  const size_t n_flat = in_flat.gaussians.size();
+  const size_t n_steep = in_steep.gaussians.size();
   EXPECT_LT(n_flat, n_steep / 4);
   expect_leaf_properties(b.last(), b.config());
 }
