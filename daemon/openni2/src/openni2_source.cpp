@@ -32,8 +32,6 @@ constexpr std::chrono::milliseconds kWaitSlice{50};
 constexpr int kFallbackWidth = 640;
 constexpr int kFallbackHeight = 480;
 constexpr int kFallbackFps = 30;
-// Bad-frame summaries at most this often (STYLE.md: never log per frame in steady state).
-constexpr int64_t kLogIntervalNs = 1'000'000'000;
 
 std::shared_ptr<spdlog::logger> logger() {
   auto log = spdlog::get("daemon");
@@ -107,6 +105,9 @@ bool intrinsics_from_stream(openni::VideoStream& stream, CameraIntrinsics* camer
 class OpenNi2SourceBase : public DepthSource {
  public:
   [[nodiscard]] CameraIntrinsics camera() const override { return camera_; }
+  // Why the last grab() returned kError or kDisconnected. (Declared without `override` so this
+  // also builds against a DepthSource that predates last_error(); it overrides it where present.)
+  [[nodiscard]] std::string last_error() const { return last_error_; }
 
   void close() override {
     if (stream_) {
@@ -198,13 +199,10 @@ class OpenNi2SourceBase : public DepthSource {
     return GrabStatus::kFrame;
   }
 
-  GrabStatus bad_frame(const std::string& what) {
+  // A bad frame: skipped and counted by the pipeline, which logs last_error() rate-limited.
+  GrabStatus bad_frame(std::string what) {
     ++bad_frames_;
-    const int64_t now = openni2::monotonic_ns();
-    if (now - last_bad_log_ns_ >= kLogIntervalNs) {
-      logger()->warn("{}: skipped a bad frame: {} ({} bad frames so far)", describe(), what, bad_frames_);
-      last_bad_log_ns_ = now;
-    }
+    last_error_ = std::move(what);
     return GrabStatus::kError;
   }
 
@@ -213,7 +211,7 @@ class OpenNi2SourceBase : public DepthSource {
   std::unique_ptr<openni::VideoStream> stream_;
   CameraIntrinsics camera_;
   uint64_t bad_frames_ = 0;
-  int64_t last_bad_log_ns_ = 0;
+  std::string last_error_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -245,7 +243,10 @@ class OpenNi2Camera final : public OpenNi2SourceBase {
   }
 
   GrabStatus grab(RawFrame& frame, std::chrono::milliseconds timeout) override {
-    if (!stream_) return GrabStatus::kDisconnected;
+    if (!stream_) {
+      last_error_ = "not open";
+      return GrabStatus::kDisconnected;
+    }
     switch (wait_ready(timeout, &watch_->lost)) {
       case Wait::kReady: {
         int index = 0;
@@ -254,12 +255,13 @@ class OpenNi2Camera final : public OpenNi2SourceBase {
       case Wait::kTimeout:
         return GrabStatus::kTimeout;
       case Wait::kLost:
-        logger()->warn("{}: device {} disconnected", describe(), open_uri_);
+        last_error_ = "OpenNI2 reported device " + open_uri_ + " disconnected";
         return GrabStatus::kDisconnected;
       case Wait::kError:
         break;
     }
     // waitForAnyStream failed outright: the stream or its device is unusable.
+    last_error_ = with_detail("waiting for a frame failed");
     return GrabStatus::kDisconnected;
   }
 
@@ -374,7 +376,7 @@ class OniRecording final : public OpenNi2SourceBase {
   }
 
   GrabStatus grab(RawFrame& frame, std::chrono::milliseconds timeout) override {
-    if (!stream_) return GrabStatus::kError;
+    if (!stream_) return bad_frame("not open");
     if (ended_) return GrabStatus::kEndOfStream;
     switch (wait_ready(timeout, nullptr)) {
       case Wait::kReady:
