@@ -138,7 +138,7 @@ int run_sequence(const Args& a) {
     handtrack::write_png_rgb(file, handtrack::view::render_frame(view, render_options(a)));
     ++written;
   }
-  if (a.every > 0) std::cerr << kProgram << ": wrote " << written << " images next to " << a.out << "\n";
+  if (a.every > 0) std::cout << kProgram << ": wrote " << written << " images next to " << a.out << "\n";
   return 0;
 }
 
