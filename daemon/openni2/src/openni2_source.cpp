@@ -32,6 +32,10 @@ constexpr std::chrono::milliseconds kWaitSlice{50};
 constexpr int kFallbackWidth = 640;
 constexpr int kFallbackHeight = 480;
 constexpr int kFallbackFps = 30;
+// A live camera without frames this long is closed and reopened (see stalled_device_gone).
+constexpr int64_t kStallReopenNs = 3'000'000'000;
+// A recording whose length OpenNI2 does not report has ended when no frame came for this long.
+constexpr int64_t kRecordingSilenceNs = 3'000'000'000;
 
 std::shared_ptr<spdlog::logger> logger() {
   auto log = spdlog::get("daemon");
@@ -250,10 +254,12 @@ class OpenNi2Camera final : public OpenNi2SourceBase {
     switch (wait_ready(timeout, &watch_->lost)) {
       case Wait::kReady: {
         int index = 0;
-        return read_ready_frame(frame, &index);
+        const GrabStatus status = read_ready_frame(frame, &index);
+        if (status == GrabStatus::kFrame) last_frame_ns_ = frame.capture_ns;
+        return status;
       }
       case Wait::kTimeout:
-        return GrabStatus::kTimeout;
+        return stalled_device_gone() ? GrabStatus::kDisconnected : GrabStatus::kTimeout;
       case Wait::kLost:
         last_error_ = "OpenNI2 reported device " + open_uri_ + " disconnected";
         return GrabStatus::kDisconnected;
@@ -266,6 +272,17 @@ class OpenNi2Camera final : public OpenNi2SourceBase {
   }
 
  private:
+  // A camera that stays silent for kStallReopenNs is treated as lost: OpenNI2 drops a device
+  // from its list only when the driver raises the disconnect event, and a driver that misses it
+  // (or a sensor that stalls while still attached) would otherwise leave grab() timing out for
+  // ever. Reopening recovers both.
+  bool stalled_device_gone() {
+    const int64_t silent_ns = openni2::monotonic_ns() - last_frame_ns_;
+    if (silent_ns < kStallReopenNs) return false;
+    last_error_ = "no frame from " + open_uri_ + " for " + std::to_string(silent_ns / 1'000'000) + " ms";
+    return true;
+  }
+
   bool open_impl(std::string* why) {
     close();
     if (!runtime_) {
@@ -301,6 +318,7 @@ class OpenNi2Camera final : public OpenNi2SourceBase {
       return false;
     }
     open_uri_ = chosen;
+    last_frame_ns_ = openni2::monotonic_ns();
     logger()->info("{}: opened {} ({}x{} at {} fps, f {:.1f}/{:.1f} px, depth unit {} mm)", describe(), chosen,
                    camera_.width, camera_.height, camera_.fps, camera_.fx, camera_.fy, camera_.depth_scale_mm);
     return true;
@@ -352,6 +370,7 @@ class OpenNi2Camera final : public OpenNi2SourceBase {
   SourceOptions options_;
   std::shared_ptr<DeviceWatch> watch_;
   std::string open_uri_;
+  int64_t last_frame_ns_ = 0;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -382,23 +401,26 @@ class OniRecording final : public OpenNi2SourceBase {
       case Wait::kReady:
         break;
       case Wait::kTimeout:
+        // Normally the end is known from the frame count; without one, silence ends a recording.
+        if (!options_.loop && frame_count_ == 0 && openni2::monotonic_ns() - last_frame_ns_ > kRecordingSilenceNs) {
+          ended_ = true;
+          return GrabStatus::kEndOfStream;
+        }
         return GrabStatus::kTimeout;
       case Wait::kLost:
       case Wait::kError:
-        return bad_frame("waitForAnyStream failed");
+        return bad_frame(with_detail("waitForAnyStream failed"));
     }
     int index = 0;
     const GrabStatus status = read_ready_frame(frame, &index);
     if (status != GrabStatus::kFrame) return status;
+    last_frame_ns_ = frame.capture_ns;
     ++frames_read_;
     // OniFile numbers a stream's frames 1..N. With repeat off nothing follows frame N (a
     // readFrame would block for ever), so the end is known from the count, not from a timeout.
     if (!options_.loop && frame_count_ > 0 && (index >= frame_count_ || frames_read_ >= frame_count_)) ended_ = true;
     return GrabStatus::kFrame;
   }
-
-  // Frames in the file's depth stream (0 when OpenNI2 does not say); valid after open().
-  [[nodiscard]] int frame_count() const { return frame_count_; }
 
  private:
   bool open_impl(std::string* why) {
@@ -430,6 +452,7 @@ class OniRecording final : public OpenNi2SourceBase {
     }
     if (!open_depth_stream(why)) return false;
     frame_count_ = std::max(0, device_->getPlaybackControl()->getNumberOfFrames(*stream_));
+    last_frame_ns_ = openni2::monotonic_ns();
     logger()->info("{}: {} depth frames {}x{} at {} fps, f {:.1f}/{:.1f} px, depth unit {} mm{}{}", describe(),
                    frame_count_, camera_.width, camera_.height, camera_.fps, camera_.fx, camera_.fy,
                    camera_.depth_scale_mm, options_.loop ? ", looped" : "",
@@ -458,6 +481,7 @@ class OniRecording final : public OpenNi2SourceBase {
   SourceOptions options_;
   int frame_count_ = 0;
   int frames_read_ = 0;
+  int64_t last_frame_ns_ = 0;
   bool ended_ = false;
 };
 

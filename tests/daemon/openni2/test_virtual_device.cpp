@@ -260,6 +260,29 @@ TEST_F(VirtualDevice, UnplugReplugCyclesLeakNoThreadsOrDescriptors) {
   EXPECT_EQ(settled(fd_count, fds_before), fds_before);
 }
 
+TEST_F(VirtualDevice, ASilentCameraIsReopened) {
+  // The device stays listed but sends nothing (a hung sensor, or a driver that missed an unplug):
+  // after 3 s of silence grab() reports it lost so that the pipeline reopens it.
+  const fs::path stall_file = std::getenv(handtrack::test::kStallFileEnv);
+  auto source = make_openni2_camera("", SourceOptions{});
+  std::string why;
+  ASSERT_TRUE(source->open(&why)) << why;
+  RawFrame frame;
+  ASSERT_EQ(frames_within(*source, 3, 1s, frame), 3);
+  std::ofstream(stall_file) << "stalled\n";
+  const auto t0 = Clock::now();
+  GrabStatus s = GrabStatus::kFrame;
+  while (s != GrabStatus::kDisconnected && Clock::now() - t0 < 6s) s = source->grab(frame, 200ms);
+  const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  EXPECT_EQ(s, GrabStatus::kDisconnected);
+  EXPECT_GT(seconds, 2.5);
+  EXPECT_LT(seconds, 4.0);
+  fs::remove(stall_file);
+  source->close();
+  ASSERT_TRUE(open_within(*source, 1s, &why)) << why;
+  EXPECT_EQ(frames_within(*source, 5, 1s, frame), 5);
+}
+
 TEST_F(VirtualDevice, TwoSourcesShareOneOpenNI2Runtime) {
   // The runtime is process-wide: a second source (e.g. while the pipeline rebuilds) neither
   // re-initializes OpenNI2 nor shuts it down under the first.

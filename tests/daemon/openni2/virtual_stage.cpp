@@ -41,6 +41,7 @@ int run_in_staged_openni2(int argc, char** argv) {
     setenv("LD_LIBRARY_PATH", path.c_str(), 1);
     setenv(kStageDirEnv, dir.c_str(), 1);
     setenv(kPlugFileEnv, (dir + "/plugged").c_str(), 1);
+    setenv(kStallFileEnv, (dir + "/stalled").c_str(), 1);
     execv("/proc/self/exe", argv);
     _exit(127);
   }

@@ -8,6 +8,8 @@ namespace handtrack::test {
 
 // The virtual driver's plug file: the device is plugged in while this path exists.
 inline constexpr const char* kPlugFileEnv = "HANDTRACK_VDEV_PLUG_FILE";
+// The virtual driver's stall file: while it exists the device sends no frames but stays listed.
+inline constexpr const char* kStallFileEnv = "HANDTRACK_VDEV_STALL_FILE";
 // Set in the child process to the staged directory.
 inline constexpr const char* kStageDirEnv = "HANDTRACK_ONI_STAGE_DIR";
 
@@ -16,7 +18,7 @@ inline constexpr const char* kStageDirEnv = "HANDTRACK_ONI_STAGE_DIR";
 std::string stage_openni2();
 
 // In the parent (no kStageDirEnv): stages, re-runs this executable with LD_LIBRARY_PATH=DIR,
-// kStageDirEnv=DIR and kPlugFileEnv=DIR/plugged, removes DIR and returns the child's exit
+// kStageDirEnv=DIR, kPlugFileEnv=DIR/plugged and kStallFileEnv=DIR/stalled, removes DIR and returns the child's exit
 // status. In the child: returns -1 and the caller runs the tests.
 int run_in_staged_openni2(int argc, char** argv);
 

@@ -6,6 +6,9 @@
 // 640x480@30 in 1 mm units, FOV 58 x 45 degrees (a PrimeSense-class sensor). Frames: a wall at
 // kWallMm with a disc (a "hand") at kBlobMm circling in front of it.
 //
+// Stall: while the file named by $HANDTRACK_VDEV_STALL_FILE exists, streams deliver nothing but
+// the device stays connected (a sensor that hangs, or a driver that misses the unplug).
+//
 // Unplug and replug: while the file named by $HANDTRACK_VDEV_PLUG_FILE exists the device is
 // plugged in (without the variable it always is). The driver's own thread polls that path every
 // kPollInterval and, like a USB driver, raises OpenNI2's deviceDisconnected/deviceConnected
@@ -46,6 +49,7 @@ namespace {
 
 constexpr const char* kUri = "handtrack-virtual://depth0";
 constexpr const char* kPlugFileEnv = "HANDTRACK_VDEV_PLUG_FILE";
+constexpr const char* kStallFileEnv = "HANDTRACK_VDEV_STALL_FILE";
 constexpr std::chrono::milliseconds kPollInterval{10};
 constexpr float kHorizontalFovRad = 1.0122910F;  // 58 degrees
 constexpr float kVerticalFovRad = 0.7853982F;    // 45 degrees
@@ -83,7 +87,10 @@ OniStatus set_value(T* value, const void* data, int size) {
 
 class DepthStream final : public oni::driver::StreamBase {
  public:
-  explicit DepthStream(const std::atomic<bool>* plugged) : plugged_(plugged) {}
+  explicit DepthStream(const std::atomic<bool>* plugged) : plugged_(plugged) {
+    const char* stall = std::getenv(kStallFileEnv);
+    stall_file_ = stall ? stall : "";
+  }
   ~DepthStream() override { stop(); }
   DepthStream(const DepthStream&) = delete;
   DepthStream& operator=(const DepthStream&) = delete;
@@ -175,6 +182,7 @@ class DepthStream final : public oni::driver::StreamBase {
       next += period;
       if (wake_.wait_until(lock, next, [this] { return !running_; })) break;
       if (!plugged_->load(std::memory_order_acquire)) continue;  // unplugged: the USB data stopped
+      if (!stall_file_.empty() && plug_file_exists(stall_file_)) continue;  // hung sensor
       const OniVideoMode mode = mode_;
       const OniBool mirrored = mirroring_;
       lock.unlock();
@@ -217,6 +225,7 @@ class DepthStream final : public oni::driver::StreamBase {
   }
 
   const std::atomic<bool>* plugged_;
+  std::string stall_file_;
   std::mutex mutex_;
   std::condition_variable wake_;
   std::thread thread_;
