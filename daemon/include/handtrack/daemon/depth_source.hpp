@@ -68,6 +68,9 @@ class DepthSource {
   [[nodiscard]] virtual CameraIntrinsics camera() const = 0;
   // True for cameras (retry open and reopen on loss), false for recordings and the virtual camera.
   [[nodiscard]] virtual bool is_live() const = 0;
+  // Why the last grab() returned kError or kDisconnected, for the log (empty: no details).
+  // Added for the pipeline's "skipped and counted" log line; a default so sources may ignore it.
+  [[nodiscard]] virtual std::string last_error() const { return {}; }
 };
 
 // Parses SRC (SPEC.md "Sources") and builds the source. Throws std::invalid_argument naming SRC
