@@ -121,7 +121,11 @@ TEST(OniRecording, PlaysAtItsOwnFrameRate) {
   ASSERT_TRUE(source->open(&why)) << why;
   const PlayResult r = play(*source, 1000);
   std::printf("oni realtime: %d frames in %.3f s\n", r.frames, r.seconds);
-  EXPECT_EQ(r.frames, kRecordingFrames);
+  // At the recording's own rate OpenNI2 keeps only the newest frame: a reader slower than 30 fps
+  // (a sanitizer build) misses some, like with a live camera. It still sees the last one, and the end.
+  EXPECT_GE(r.frames, kRecordingFrames - 4);
+  ASSERT_FALSE(r.indexes.empty());
+  EXPECT_EQ(r.indexes.back(), static_cast<uint64_t>(kRecordingFrames));
   EXPECT_EQ(r.last, GrabStatus::kEndOfStream);
   // 24 frames at 30 fps: about 0.77 s of recording (23 frame intervals).
   EXPECT_GT(r.seconds, 0.55);
