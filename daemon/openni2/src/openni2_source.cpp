@@ -109,9 +109,7 @@ bool intrinsics_from_stream(openni::VideoStream& stream, CameraIntrinsics* camer
 class OpenNi2SourceBase : public DepthSource {
  public:
   [[nodiscard]] CameraIntrinsics camera() const override { return camera_; }
-  // Why the last grab() returned kError or kDisconnected. (Declared without `override` so this
-  // also builds against a DepthSource that predates last_error(); it overrides it where present.)
-  [[nodiscard]] std::string last_error() const { return last_error_; }
+  [[nodiscard]] std::string last_error() const override { return last_error_; }
 
   void close() override {
     if (stream_) {
