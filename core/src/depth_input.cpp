@@ -14,8 +14,11 @@ namespace {
 using Eigen::Vector3d;
 
 // Radius around the palm centre that holds the whole hand, in hand lengths: an extended middle
-// fingertip is ~0.75 hand lengths from the palm centre; the margin allows for motion between frames.
-constexpr double kHandRadiusInLengths = 0.85;
+// fingertip is ~0.75 hand lengths from the palm centre; the margin allows for motion between frames
+// and a palm centre that is off.
+constexpr double kHandRadiusInLengths = 1.0;
+// A hand is at most this many default hand lengths long (subjects vary by about 10 %).
+constexpr double kHandLengthMargin = 1.1;
 // The forearm is cut this far below the wrist joint (mm): the wrist's own surface stays in.
 constexpr double kWristCutMarginMm = 10.0;
 // Pixels this close to the image border mark the end of a blob where the arm leaves the image.
@@ -119,15 +122,27 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
     found = true;
   }
   // Keeps pixels near `centre` and above the wrist plane; returns how many.
+  // Keeps the pixels near `centre` and above the forearm cut. The cut is the wrist plane, but never
+  // lower than one (generous) hand length below the farthest point along the axis: a wrist that
+  // drifted down the forearm must not let the forearm in, or the model follows it further down.
   const auto select = [&]() {
-    int count = 0;
+    double tip = -std::numeric_limits<double>::infinity();
     for (size_t i = 0; i < n; ++i) {
       out_.hand_mask[i] = 0;
       if (d[i] <= 0.0F) continue;
       const Vector3d p = point(i);
       if ((p - centre).squaredNorm() > hand_radius * hand_radius) continue;
-      if ((p - wrist).dot(axis) < -kWristCutMarginMm) continue;
       out_.hand_mask[i] = 1;
+      tip = std::max(tip, p.dot(axis));
+    }
+    const double cut = std::max(wrist.dot(axis) - kWristCutMarginMm, tip - kHandLengthMargin * config_.hand_length_mm);
+    int count = 0;
+    for (size_t i = 0; i < n; ++i) {
+      if (!out_.hand_mask[i]) continue;
+      if (point(i).dot(axis) < cut) {
+        out_.hand_mask[i] = 0;
+        continue;
+      }
       ++count;
     }
     return count;

@@ -21,6 +21,10 @@ constexpr double kClosedFingersInFrontMm = 40.0;
 constexpr double kPinchOpenMm = 40.0;
 }  // namespace
 
+const char* to_string(EnergyMode mode) {
+  return mode == EnergyMode::kLateFusion ? "late-fusion" : "depth-only";
+}
+
 const char* to_string(TrackingState state) {
   switch (state) {
     case TrackingState::kNoHand: return "no_hand";
@@ -34,6 +38,7 @@ PoseTracker::PoseTracker(TrackerConfig config)
     : config_(config),
       model_(HandModel::default_adult(config.scale)),
       energy_(SimilarityFactor::kDepth, config.weights),
+      guided_energy_(SimilarityFactor::kLabel, config.weights),
       optimizer_(config.optimizer),
       rng_(config.seed) {}
 
@@ -166,6 +171,11 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
 
   OptimizerResult best{PoseParams::Zero(), -1e300};
   int winner = -1;
+  bool guided_won = false;
+  // Late fusion needs part labels on the leaves; without them every particle is depth-only.
+  const bool labelled = std::any_of(input.gaussians.begin(), input.gaussians.end(),
+                                    [](const ImageGaussian& g) { return g.label != kBackground; });
+  const bool fuse = config_.mode == EnergyMode::kLateFusion && labelled;
   if (!previous_) {
     best = start();
     recovering_ = true;
@@ -177,10 +187,16 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     for (int i = 0; i < config_.particles; ++i) {
       PoseParams particle = *previous_;
       for (int j = 0; j < kNumPoseParams; ++j) particle[j] += alpha(rng_) * velocity[j];
-      const auto r = optimizer_.maximise(energy_, frame, particle, scratch_);
+      const bool guided = fuse && i == config_.particles - 1;
+      auto r = optimizer_.maximise(guided ? guided_energy_ : energy_, frame, particle, scratch_);
+      // Late fusion (Sec. 5): "the pose particle which converges with the best energy value is
+      // chosen". The two energies differ in scale, so every particle is judged by one common
+      // energy: the depth-only E of eq. 2 at its final pose.
+      if (guided) r.energy = energy_.evaluate(frame, r.params, scratch_, nullptr);
       if (r.energy > best.energy) {
         best = r;
         winner = i;
+        guided_won = guided;
       }
     }
   }
@@ -193,6 +209,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     frame.previous = frame.before_previous = nullptr;
     best = start();
     winner = -1;
+    guided_won = false;
     scratch_.update(model_, best.params);
     conf = confidence(input, scratch_);
     recovering_ = true;
@@ -206,6 +223,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   auto out = describe(best.params, best.energy, input, recovering_ ? TrackingState::kRecovering : TrackingState::kTracking);
   out.confidence = conf;
   out.winning_particle = winner;
+  out.detection_guided_won = guided_won;
   return out;
 }
 

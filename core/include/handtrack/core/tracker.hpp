@@ -23,7 +23,15 @@ namespace handtrack {
 enum class TrackingState : uint8_t { kNoHand = 0, kTracking = 1, kRecovering = 2 };
 const char* to_string(TrackingState state);
 
+// Which energies the particles optimise (Sec. 5).
+enum class EnergyMode {
+  kDepthOnly,   // every particle: the depth-only energy (Sec. 4.1)
+  kLateFusion,  // all but one particle depth-only, one the detection-guided energy (Sec. 4.3)
+};
+const char* to_string(EnergyMode mode);
+
 struct TrackerConfig {
+  EnergyMode mode = EnergyMode::kDepthOnly;
   DepthInputConfig input;
   EnergyWeights weights;
   OptimizerConfig optimizer;
@@ -49,7 +57,8 @@ struct TrackerOutput {
   double confidence = 0.0;           // fraction of the hand's depth explained by the model, in [0, 1]
   double pinch_distance_mm = 0.0;    // thumb tip to index tip, surface to surface
   double pinch_strength = 0.0;       // 1 = touching, 0 = apart (>= 40 mm)
-  int winning_particle = -1;
+  int winning_particle = -1;         // -1: a (re)start, not a particle
+  bool detection_guided_won = false;  // late fusion: the detection-guided particle won
 };
 
 class PoseTracker {
@@ -78,7 +87,8 @@ class PoseTracker {
 
   TrackerConfig config_;
   HandModel model_;
-  PoseEnergy energy_;
+  PoseEnergy energy_;            // depth-only: also the common energy late fusion compares with
+  PoseEnergy guided_energy_;     // detection-guided (label similarity factor)
   AdaptiveGradientAscent optimizer_;
   PosedHand scratch_;
   std::mt19937_64 rng_;
