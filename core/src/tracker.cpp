@@ -142,8 +142,10 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   if (!input.has_hand()) {
     reset();
     recovering_ = true;
-    TrackerOutput none;
+    TrackerOutput none;  // no pose is invented: everything zero
     none.state = TrackingState::kNoHand;
+    none.joints.fill(Vector3d::Zero());
+    none.fingertips.fill(Vector3d::Zero());
     return none;
   }
   EnergyFrame frame{&model_, &input, nullptr, nullptr};
