@@ -1,0 +1,121 @@
+// handtrackd's configuration: the paper's values as defaults, the shipped file equal to them,
+// every bad value refused with the file, the field and the range; and make_source's parsing.
+#include "handtrack/daemon/config.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+namespace handtrack::daemon {
+namespace {
+
+std::string error_of(const std::string& toml) {
+  try {
+    (void)parse_config(toml, "test.toml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+TEST(DaemonConfig, DefaultsAreThePapersValues) {
+  const DaemonConfig c;
+  EXPECT_EQ(c.tracker.particles, 2);                     // Sec. 7
+  EXPECT_EQ(c.tracker.optimizer.iterations, 10);         // Sec. 7
+  EXPECT_DOUBLE_EQ(c.tracker.weights.collision, 1.0);    // w_c, Sec. 4.1
+  EXPECT_DOUBLE_EQ(c.tracker.weights.limits, 0.2);       // w_l
+  EXPECT_DOUBLE_EQ(c.tracker.weights.smoothness, 1.0);   // w_s
+  EXPECT_DOUBLE_EQ(c.tracker.weights.label_radius_mm, 200.0);  // R_i, Sec. 4.3
+  EXPECT_DOUBLE_EQ(c.tracker.input.near_mm, 150.0);      // Sec. 4
+  EXPECT_DOUBLE_EQ(c.tracker.input.far_mm, 600.0);
+  EXPECT_DOUBLE_EQ(c.tracker.input.quadtree_threshold_mm, 20.0);  // epsilon_c, Sec. 3.1
+  EXPECT_EQ(c.source, "openni2");
+  EXPECT_EQ(c.shm_name, "handtrack");
+}
+
+TEST(DaemonConfig, ShippedFileEqualsTheDefaults) {
+  const auto file = std::string(HANDTRACK_SOURCE_DIR) + "/data/handtrackd.toml";
+  const DaemonConfig shipped = load_config(file, true);
+  EXPECT_EQ(describe_config(shipped), describe_config(DaemonConfig{}));
+  // And describe_config writes exactly the shipped file (regenerate with handtrackd --print-config).
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(text.str(), describe_config(DaemonConfig{}));
+}
+
+TEST(DaemonConfig, ValuesOverrideDefaults) {
+  const auto c = parse_config(
+      "[daemon]\nsource = \"synthetic:pinch\"\nlog_level = \"debug\"\n"
+      "[tracker]\nparticles = 1\n[tracker.energy]\nw_s = 0.5\n[tracker.optimizer]\niterations = 20\n"
+      "[tracker.input]\nfar_mm = 700\n[pipeline]\ncpu_optimize = 1\n",
+      "x.toml");
+  EXPECT_EQ(c.source, "synthetic:pinch");
+  EXPECT_EQ(c.log_level, LogLevel::kDebug);
+  EXPECT_EQ(c.tracker.particles, 1);
+  EXPECT_DOUBLE_EQ(c.tracker.weights.smoothness, 0.5);
+  EXPECT_EQ(c.tracker.optimizer.iterations, 20);
+  EXPECT_DOUBLE_EQ(c.tracker.input.far_mm, 700.0);  // an integer is a fine number
+  EXPECT_EQ(c.pipeline.cpu[static_cast<size_t>(Stage::kOptimize)], 1);
+  EXPECT_DOUBLE_EQ(c.tracker.weights.collision, 1.0);  // untouched
+}
+
+TEST(DaemonConfig, BadValuesNameFileFieldAndRange) {
+  EXPECT_EQ(error_of("[tracker]\nparticles = 65\n"), "test.toml: tracker.particles = 65 is out of range (allowed range 1..64)");
+  EXPECT_EQ(error_of("[tracker.energy]\nw_l = -0.1\n"),
+            "test.toml: tracker.energy.w_l = -0.1 is out of range (allowed range 0.0..1000.0)");
+  EXPECT_EQ(error_of("[tracker.energy]\nw_l = nan\n").rfind("test.toml: tracker.energy.w_l = nan is out of range", 0), 0U);
+  EXPECT_EQ(error_of("[tracker]\nparticles = 1.5\n"),
+            "test.toml: tracker.particles must be an integer (allowed range 1..64)");
+  EXPECT_EQ(error_of("[daemon]\nfast = 1\n"), "test.toml: daemon.fast must be true or false");
+  EXPECT_EQ(error_of("[daemon]\nsource = \"\"\n"),
+            "test.toml: daemon.source = '': allowed: a string of 1 to 4096 characters");
+  EXPECT_NE(error_of("[nope]\nx = 1\n").find("unknown field 'nope.x'"), std::string::npos);
+  EXPECT_NE(error_of("particles = 2\n").find("unknown field 'particles'"), std::string::npos);
+  EXPECT_NE(error_of("[tracker]\nparticles = = 2\n").find("test.toml:2:"), std::string::npos);
+  EXPECT_NE(error_of("[tracker.input]\nquadtree_min_leaf_px = 64\nquadtree_root_px = 16\n")
+                .find("quadtree_min_leaf_px = 64 must not exceed"),
+            std::string::npos);
+}
+
+TEST(DaemonConfig, MissingDefaultFileIsFineMissingExplicitFileIsNot) {
+  EXPECT_NO_THROW((void)load_config("/nonexistent/handtrackd.toml", false));
+  EXPECT_THROW((void)load_config("/nonexistent/handtrackd.toml", true), ConfigError);
+}
+
+TEST(DaemonConfig, ReloadTellsWhichFieldsNeedARestart) {
+  DaemonConfig a;
+  DaemonConfig b;
+  b.tracker.particles = 1;
+  b.log_level = LogLevel::kDebug;
+  EXPECT_TRUE(changed_but_not_live(a, b).empty());
+  b.shm_name = "other";
+  b.pipeline.queue_capacity = 3;
+  EXPECT_EQ(changed_but_not_live(a, b), (std::vector<std::string>{"daemon.shm_name", "pipeline.queue_capacity"}));
+}
+
+TEST(MakeSource, RefusesMalformedSpecsNamingThem) {
+  SourceOptions o;
+  for (const std::string spec : {"webcam", "seq:", "oni:", "synthetic:", "synthetic:juggle", "openni2:"}) {
+    try {
+      (void)make_source(spec, o);
+      ADD_FAILURE() << spec << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(spec.substr(0, spec.find(':'))), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(make_source("synthetic:pinch", o)->describe(), "synthetic:pinch");
+  EXPECT_EQ(make_source("seq:/some/dir", o)->describe(), "seq:/some/dir");
+  EXPECT_FALSE(make_source("synthetic", o)->is_live());
+}
+
+TEST(MakeSource, SequenceSourceReportsWhyItCannotOpen) {
+  auto s = make_source("seq:/nonexistent/sequence", SourceOptions{});
+  std::string why;
+  EXPECT_FALSE(s->open(&why));
+  EXPECT_NE(why.find("/nonexistent/sequence"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace handtrack::daemon

@@ -1,0 +1,493 @@
+// The real handtrackd binary, driven like a user or systemd would: poses read by the real
+// handtrack-cat and compared with ground truth (seq: and synthetic: sources), the sd_notify
+// protocol on a NOTIFY_SOCKET this test listens on (READY, watchdog pings that stop when the
+// optimizer stalls, STATUS), clean SIGTERM, SIGHUP reload, --record, and bad input of every kind.
+#include "child_process.hpp"
+#include "handtrack/core/png_io.hpp"
+#include "handtrack/core/sequence.hpp"
+#include "handtrack/daemon/synthetic_source.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sys/socket.h>
+#include <sys/un.h>
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <regex>
+#include <thread>
+
+namespace handtrack::test {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+
+const std::string kDaemon = HANDTRACKD_EXE;
+const std::string kCat = HANDTRACK_CAT_EXE;
+const std::string kSynth = HANDTRACK_SYNTH_EXE;
+constexpr double kMaxMeanFingertipErrorMm = 40.0;
+
+struct Run {
+  int code = -1;
+  std::string out, err;
+};
+
+Run run(const std::vector<std::string>& argv, const TempDir& dir, const std::string& tag,
+        std::chrono::milliseconds timeout = 30s, const std::vector<std::string>& env = {}) {
+  Child child(argv, dir / (tag + ".out"), dir / (tag + ".err"), env);
+  const auto code = child.wait(timeout);
+  return {code.value_or(-1), child.out(), child.err()};
+}
+
+// Mean fingertip error (mm) of the cat's JSON lines against `truth(frame)`.
+template <typename Truth>
+double mean_fingertip_error(const std::vector<json>& poses, Truth truth) {
+  double sum = 0.0;
+  int frames = 0;
+  for (const auto& p : poses) {
+    const Fingertips tips = truth(p.at("frame").get<int>());
+    double frame_sum = 0.0;
+    int n = 0;
+    for (int f = 0; f < kNumFingers; ++f) {
+      if (!tips[static_cast<size_t>(f)]) continue;
+      const auto& t = p.at("fingertips").at(static_cast<size_t>(f));
+      const Eigen::Vector3d got(t.at(0).get<double>(), t.at(1).get<double>(), t.at(2).get<double>());
+      frame_sum += (got - *tips[static_cast<size_t>(f)]).norm();
+      ++n;
+    }
+    if (n == 0) continue;
+    sum += frame_sum / n;
+    ++frames;
+  }
+  return frames > 0 ? sum / frames : 1e9;
+}
+
+std::vector<json> parse_lines(const std::string& text) {
+  std::vector<json> out;
+  for (const auto& line : lines_of(text)) out.push_back(json::parse(line));
+  return out;
+}
+
+// The numbers of handtrackd's last line ("stopped: N frames captured, M published ...").
+struct Summary {
+  int captured = -1, published = -1, dropped = -1, skipped = -1, empty = -1, source_errors = -1;
+};
+Summary summary_of(const std::string& err) {
+  static const std::regex re(
+      R"((\d+) frames captured, (\d+) published in [0-9.]+ s \([0-9.]+ fps\), (\d+) dropped, (\d+) skipped, (\d+) empty, (\d+) source errors)");
+  std::smatch m;
+  Summary s;
+  if (std::regex_search(err, m, re)) {
+    s = {std::stoi(m[1]), std::stoi(m[2]), std::stoi(m[3]), std::stoi(m[4]), std::stoi(m[5]), std::stoi(m[6])};
+  }
+  return s;
+}
+
+json cat_status(const std::string& shm, const TempDir& dir) {
+  const auto r = run({kCat, "--shm-name", shm, "--status"}, dir, "status", 10s);
+  return r.code == 0 ? json::parse(r.out) : json{};
+}
+
+class Handtrackd : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scratch_ = new TempDir("suite");
+    pinch_ = scratch_->path() / "pinch";
+    const auto r = run({kSynth, "--motion", "pinch", "--frames", "60", "--out", pinch_.string()}, *scratch_, "synth",
+                       120s);
+    ASSERT_EQ(r.code, 0) << r.err;
+  }
+  static void TearDownTestSuite() {
+    delete scratch_;
+    scratch_ = nullptr;
+  }
+  void SetUp() override {
+    std::ofstream(dir_ / "empty.toml") << "# no overrides: built-in defaults\n";
+  }
+  // handtrackd with a hermetic (empty) config unless the arguments name one.
+  std::vector<std::string> daemon_args(std::vector<std::string> args) const {
+    if (std::find(args.begin(), args.end(), "--config") == args.end()) {
+      args.insert(args.begin(), {"--config", (dir_ / "empty.toml").string()});
+    }
+    args.insert(args.begin(), kDaemon);
+    return args;
+  }
+  // A copy of the pinch sequence to damage.
+  fs::path copy_of_pinch(const std::string& name) const {
+    const auto to = dir_ / name;
+    fs::copy(pinch_, to, fs::copy_options::recursive);
+    return to;
+  }
+
+  static inline TempDir* scratch_ = nullptr;
+  static inline fs::path pinch_;
+  TempDir dir_{::testing::UnitTest::GetInstance()->current_test_info()->name()};
+};
+
+TEST_F(Handtrackd, HelpExitsZero) {
+  const auto r = run({kDaemon, "--help"}, dir_, "help");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("--source"), std::string::npos);
+  EXPECT_NE(r.out.find("--shm-name"), std::string::npos);
+}
+
+TEST_F(Handtrackd, SeqSourceFingertipsMatchGroundTruth) {
+  ShmName shm("seq");
+  Child cat({kCat, "--shm-name", shm.str(), "--count", "40", "--timeout", "30"}, dir_ / "cat.out", dir_ / "cat.err");
+  const auto r = run(daemon_args({"--source", "seq:" + pinch_.string(), "--fast", "--shm-name", shm.str()}), dir_,
+                     "daemon", 60s);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("60 frames captured, 60 published"), std::string::npos) << r.err;
+  ASSERT_EQ(cat.wait(30s), 0) << cat.err();
+  const auto poses = parse_lines(cat.out());
+  ASSERT_EQ(poses.size(), 40U);
+  const SequenceReader truth(pinch_);
+  const double error = mean_fingertip_error(poses, [&](int frame) { return truth.fingertips(static_cast<size_t>(frame)); });
+  std::printf("seq: mean fingertip error over %zu poses: %.1f mm\n", poses.size(), error);
+  EXPECT_LT(error, kMaxMeanFingertipErrorMm);
+  for (const auto& p : poses) {
+    EXPECT_EQ(p.at("params").size(), 26U);
+    EXPECT_EQ(p.at("joints").size(), 21U);
+    EXPECT_GT(p.at("publish_ns").get<int64_t>(), p.at("capture_ns").get<int64_t>());
+  }
+  EXPECT_EQ(poses.back().at("state"), "tracking");
+  // The daemon exited at the end of the recording: the ring says so.
+  EXPECT_EQ(cat_status(shm.str(), dir_).value("device_state", ""), "stopped");
+}
+
+TEST_F(Handtrackd, SyntheticSourceFingertipsMatchGroundTruth) {
+  ShmName shm("synthetic");
+  Child cat({kCat, "--shm-name", shm.str(), "--count", "60", "--timeout", "30"}, dir_ / "cat.out", dir_ / "cat.err");
+  const auto r = run(daemon_args({"--source", "synthetic:pinch", "--fast", "--frames", "90", "--shm-name", shm.str()}),
+                     dir_, "daemon", 60s);
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_EQ(cat.wait(30s), 0) << cat.err();
+  const auto poses = parse_lines(cat.out());
+  ASSERT_EQ(poses.size(), 60U);
+  synth::SyntheticCamera camera(daemon::synthetic_camera_options("pinch", daemon::SourceOptions{}));
+  const double error = mean_fingertip_error(poses, [&](int frame) { return camera.render(frame).fingertips; });
+  std::printf("synthetic: mean fingertip error over %zu poses: %.1f mm\n", poses.size(), error);
+  EXPECT_LT(error, kMaxMeanFingertipErrorMm);
+  const auto& last = poses.back();
+  EXPECT_GE(last.at("pinch").at("strength").get<double>(), 0.0);
+  EXPECT_GT(last.at("confidence").get<double>(), 0.0);
+  EXPECT_NEAR(last.at("hand_scale").at("length").get<double>(), 1.0, 1e-6);
+}
+
+// ---- sd_notify -------------------------------------------------------------------------------
+
+class NotifyListener {
+ public:
+  explicit NotifyListener(const fs::path& path) : path_(path) {
+    fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    sockaddr_un addr{};
+    addr.sun_family = AF_UNIX;
+    std::snprintf(addr.sun_path, sizeof addr.sun_path, "%s", path.c_str());
+    fs::remove(path);
+    bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
+    timeval tv{0, 20000};
+    setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    thread_ = std::thread([this] {
+      char buffer[4096];
+      while (!done_) {
+        const ssize_t n = recv(fd_, buffer, sizeof buffer - 1, 0);
+        if (n <= 0) continue;
+        const std::string text(buffer, static_cast<size_t>(n));
+        std::lock_guard lock(mutex_);
+        for (const auto& line : lines_of(text)) messages_.push_back({Clock::now(), line});
+      }
+    });
+  }
+  ~NotifyListener() {
+    done_ = true;
+    thread_.join();
+    close(fd_);
+    fs::remove(path_);
+  }
+  NotifyListener(const NotifyListener&) = delete;
+  NotifyListener& operator=(const NotifyListener&) = delete;
+
+  struct Message {
+    Clock::time_point when;
+    std::string text;
+  };
+  std::vector<Message> messages() {
+    std::lock_guard lock(mutex_);
+    return messages_;
+  }
+  std::string env() const { return "NOTIFY_SOCKET=" + path_.string(); }
+
+ private:
+  fs::path path_;
+  int fd_ = -1;
+  std::atomic<bool> done_{false};
+  std::thread thread_;
+  std::mutex mutex_;
+  std::vector<Message> messages_;
+};
+
+std::vector<Clock::time_point> times_of(const std::vector<NotifyListener::Message>& m, const std::string& prefix) {
+  std::vector<Clock::time_point> out;
+  for (const auto& x : m) {
+    if (x.text.rfind(prefix, 0) == 0) out.push_back(x.when);
+  }
+  return out;
+}
+
+bool any_starts(const std::vector<NotifyListener::Message>& m, const std::string& prefix, const std::string& contains = "") {
+  return std::any_of(m.begin(), m.end(), [&](const auto& x) {
+    return x.text.rfind(prefix, 0) == 0 && x.text.find(contains) != std::string::npos;
+  });
+}
+
+TEST_F(Handtrackd, NotifiesReadyStatusAndWatchdogWhileProgressing) {
+  ShmName shm("notify");
+  NotifyListener listener(dir_ / "notify.sock");
+  Child d(daemon_args({"--source", "synthetic:pinch", "--shm-name", shm.str()}), dir_ / "d.out", dir_ / "d.err",
+          {listener.env(), "WATCHDOG_USEC=400000"});
+  std::this_thread::sleep_for(3s);
+  const auto end = Clock::now();
+  d.signal(SIGTERM);
+  ASSERT_EQ(d.wait(10s), 0) << d.err();
+  const auto m = listener.messages();
+  ASSERT_FALSE(m.empty());
+  EXPECT_EQ(m.front().text, "READY=1");
+  EXPECT_TRUE(any_starts(m, "STATUS=", "fps")) << "no STATUS= with the frame rate";
+  EXPECT_TRUE(any_starts(m, "STOPPING=1"));
+  const auto pings = times_of(m, "WATCHDOG=1");
+  // WatchdogSec = 0.4 s: a ping every 0.2 s while the pipeline makes progress.
+  EXPECT_GE(pings.size(), 8U);
+  ASSERT_FALSE(pings.empty());
+  EXPECT_LT(end - pings.back(), 600ms) << "pings stopped although the pipeline was progressing";
+}
+
+TEST_F(Handtrackd, WatchdogPingsStopWhenTheOptimizerStalls) {
+  ShmName shm("stall");
+  NotifyListener listener(dir_ / "notify.sock");
+  Child d(daemon_args({"--source", "synthetic:pinch", "--shm-name", shm.str()}), dir_ / "d.out", dir_ / "d.err",
+          {listener.env(), "WATCHDOG_USEC=400000", "HANDTRACKD_TEST_STALL_OPTIMIZER_AFTER=30"});
+  std::this_thread::sleep_for(3500ms);
+  const auto end = Clock::now();
+  const auto status = cat_status(shm.str(), dir_);
+  d.signal(SIGTERM);
+  ASSERT_EQ(d.wait(10s), 0) << "a stalled daemon must still stop cleanly\n" << d.err();
+  const auto m = listener.messages();
+  const auto pings = times_of(m, "WATCHDOG=1");
+  ASSERT_FALSE(pings.empty()) << "no ping before the stall";
+  EXPECT_GT(end - pings.back(), 1500ms) << "watchdog pings went on while the optimizer was stalled";
+  EXPECT_TRUE(any_starts(m, "STATUS=stalled", "optimize")) << "no STATUS=stalled naming the optimize stage";
+  EXPECT_NE(d.err().find("pipeline stalled (optimize busy"), std::string::npos) << d.err();
+  // The ring's heartbeat stops too: clients see a dead writer, not a live one without poses.
+  EXPECT_EQ(status.value("alive", true), false) << status.dump();
+}
+
+TEST_F(Handtrackd, SigtermStopsCleanlyAndMarksTheRingStopped) {
+  ShmName shm("sigterm");
+  Child d(daemon_args({"--source", "synthetic", "--shm-name", shm.str()}), dir_ / "d.out", dir_ / "d.err");
+  const auto cat = run({kCat, "--shm-name", shm.str(), "--count", "10", "--timeout", "20"}, dir_, "cat", 30s);
+  ASSERT_EQ(cat.code, 0) << cat.err;
+  const auto live = cat_status(shm.str(), dir_);
+  EXPECT_EQ(live.value("device_state", ""), "streaming");
+  EXPECT_EQ(live.value("alive", false), true);
+  d.signal(SIGTERM);
+  const auto t0 = Clock::now();
+  ASSERT_EQ(d.wait(5s), 0) << d.err();
+  EXPECT_LT(Clock::now() - t0, 2s);
+  EXPECT_NE(d.err().find("SIGTERM: stopping"), std::string::npos);
+  const auto stopped = cat_status(shm.str(), dir_);
+  EXPECT_EQ(stopped.value("device_state", ""), "stopped");
+  EXPECT_EQ(stopped.value("alive", true), false);
+}
+
+TEST_F(Handtrackd, SighupReloadsLiveFieldsAndRefusesBadValues) {
+  ShmName shm("sighup");
+  const auto config = dir_ / "handtrackd.toml";
+  std::ofstream(config) << "[tracker]\nparticles = 2\n";
+  Child d(daemon_args({"--config", config.string(), "--source", "synthetic:pinch", "--shm-name", shm.str()}),
+          dir_ / "d.out", dir_ / "d.err");
+  ASSERT_EQ(run({kCat, "--shm-name", shm.str(), "--count", "5", "--timeout", "20"}, dir_, "cat1", 30s).code, 0);
+  std::ofstream(config) << "[daemon]\nlog_level = \"debug\"\nring_capacity = 64\n[tracker]\nparticles = 1\n";
+  d.signal(SIGHUP);
+  std::this_thread::sleep_for(1500ms);
+  std::ofstream(config) << "[tracker]\nparticles = 0\n";
+  d.signal(SIGHUP);
+  // Still tracking after the refused reload.
+  ASSERT_EQ(run({kCat, "--shm-name", shm.str(), "--count", "5", "--timeout", "20"}, dir_, "cat2", 30s).code, 0);
+  d.signal(SIGTERM);
+  ASSERT_EQ(d.wait(10s), 0);
+  const auto err = d.err();
+  EXPECT_NE(err.find("SIGHUP: configuration reloaded"), std::string::npos) << err;
+  EXPECT_NE(err.find("tracker parameters reloaded (1 particles"), std::string::npos) << err;
+  EXPECT_NE(err.find("daemon.ring_capacity changed but only take effect after a restart"), std::string::npos) << err;
+  EXPECT_NE(err.find("debug:"), std::string::npos) << "the new log level was not applied\n" << err;
+  EXPECT_NE(err.find("reload refused"), std::string::npos) << err;
+  EXPECT_NE(err.find("tracker.particles = 0 is out of range"), std::string::npos) << err;
+}
+
+TEST_F(Handtrackd, RecordWritesASequenceDirectory) {
+  ShmName shm("record");
+  const auto out = dir_ / "recorded";
+  const auto r = run(daemon_args({"--source", "synthetic:pinch", "--fast", "--frames", "30", "--record", out.string(),
+                                  "--shm-name", shm.str()}),
+                     dir_, "daemon", 60s);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("30 recorded"), std::string::npos) << r.err;
+  const SequenceReader recorded(out);
+  ASSERT_EQ(recorded.frame_count(), 30U);
+  synth::SyntheticCamera camera(daemon::synthetic_camera_options("pinch", daemon::SourceOptions{}));
+  for (const size_t i : {size_t{0}, size_t{29}}) {
+    const auto got = recorded.depth(i);
+    const auto want = camera.render(recorded.frame_number(i)).depth;
+    ASSERT_EQ(got.depth_mm.size(), want.depth_mm.size());
+    double worst = 0.0;
+    for (size_t k = 0; k < got.depth_mm.size(); ++k) {
+      worst = std::max(worst, std::abs(double{got.depth_mm[k]} - double{want.depth_mm[k]}));
+    }
+    EXPECT_LE(worst, 0.5) << "frame " << i;  // raw = mm rounded to 1 mm units
+  }
+}
+
+// ---- bad input -------------------------------------------------------------------------------
+
+// One line on stderr, naming what it must, and a non-zero exit; no shared memory left behind.
+void expect_one_line_error(const Run& r, const std::vector<std::string>& names) {
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.code, -1) << "did not exit";
+  const auto lines = lines_of(r.err);
+  EXPECT_EQ(lines.size(), 1U) << r.err;
+  for (const auto& n : names) EXPECT_NE(r.err.find(n), std::string::npos) << "'" << n << "' missing in: " << r.err;
+}
+
+TEST_F(Handtrackd, MissingSequenceDirectoryIsAClearError) {
+  ShmName shm("missing");
+  const auto r = run(daemon_args({"--source", "seq:" + (dir_ / "nothing").string(), "--shm-name", shm.str()}), dir_, "d");
+  expect_one_line_error(r, {(dir_ / "nothing").string()});
+  EXPECT_FALSE(fs::exists("/dev/shm/" + shm.str())) << "a failed start leaves no ring behind";
+}
+
+TEST_F(Handtrackd, CorruptOrWrongCameraJsonIsAClearError) {
+  ShmName shm("camjson");
+  const auto seq = copy_of_pinch("seq");
+  std::ofstream(seq / "camera.json") << "{\"width\": 320, \"height\": ";
+  expect_one_line_error(run(daemon_args({"--source", "seq:" + seq.string(), "--shm-name", shm.str()}), dir_, "d1"),
+                        {"camera.json"});
+  std::ofstream(seq / "camera.json")
+      << R"({"width":-320,"height":240,"fx":224.5,"fy":230.5,"cx":160,"cy":120,"depth_scale_mm":1,"fps":60})";
+  expect_one_line_error(run(daemon_args({"--source", "seq:" + seq.string(), "--shm-name", shm.str()}), dir_, "d2"),
+                        {"camera.json", "width"});
+}
+
+TEST_F(Handtrackd, CorruptPngFramesAreSkippedAndCounted) {
+  ShmName shm("png");
+  const auto seq = copy_of_pinch("seq");
+  std::ofstream(seq / "depth" / "000010.png") << "this is not a PNG";
+  {
+    const auto png = read_text(seq / "depth" / "000020.png");
+    std::ofstream(seq / "depth" / "000020.png", std::ios::binary) << png.substr(0, png.size() / 2);  // truncated
+  }
+  const auto r = run(daemon_args({"--source", "seq:" + seq.string(), "--fast", "--shm-name", shm.str()}), dir_, "d", 60s);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("bad frame skipped"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("000010.png"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("58 frames captured, 58 published"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("2 source errors"), std::string::npos) << r.err;
+}
+
+TEST_F(Handtrackd, ResolutionChangeInASequenceIsSkippedAndCounted) {
+  ShmName shm("resolution");
+  const auto seq = dir_ / "mixed";
+  const auto camera = synth::default_camera(320, 240);
+  {
+    SequenceWriter writer(seq, camera);
+    synth::SyntheticCamera small(daemon::synthetic_camera_options("pinch", daemon::SourceOptions{}));
+    for (int i = 0; i < 20; ++i) writer.write_depth(i, small.render(i).depth);
+  }
+  Gray16Image big{640, 480, 1, std::vector<uint16_t>(640 * 480, 400)};
+  for (int i = 10; i < 15; ++i) write_png_gray16(frame_file(seq / "depth", i), big);
+  const auto r = run(daemon_args({"--source", "seq:" + seq.string(), "--fast", "--shm-name", shm.str()}), dir_, "d", 60s);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("is 640x480 but camera.json says 320x240"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("15 frames captured, 15 published"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("5 source errors"), std::string::npos) << r.err;
+}
+
+TEST_F(Handtrackd, AllZeroAndAllMaxRangeFramesAreNoHand) {
+  ShmName shm("empty");
+  const auto seq = dir_ / "blank";
+  constexpr int kFrames = 30;
+  {
+    SequenceWriter writer(seq, synth::default_camera(320, 240));
+    Gray16Image zero{320, 240, 1, std::vector<uint16_t>(320 * 240, 0)};
+    Gray16Image far{320, 240, 1, std::vector<uint16_t>(320 * 240, 65535)};
+    for (int i = 0; i < kFrames; ++i) writer.write_depth_raw(i, i % 2 == 0 ? zero : far);
+  }
+  Child cat({kCat, "--shm-name", shm.str(), "--count", "10", "--timeout", "20"}, dir_ / "cat.out", dir_ / "cat.err");
+  // Paced at 60 fps, so the cat has attached before most frames come.
+  const auto r = run(daemon_args({"--source", "seq:" + seq.string(), "--shm-name", shm.str()}), dir_, "d", 60s);
+  EXPECT_EQ(r.code, 0) << r.err;
+  const auto s = summary_of(r.err);
+  EXPECT_EQ(s.captured, kFrames) << r.err;
+  EXPECT_GT(s.published, 0);
+  EXPECT_EQ(s.empty, s.published) << "every published frame without depth counts as empty\n" << r.err;
+  EXPECT_EQ(s.published + s.dropped, kFrames) << r.err;
+  ASSERT_EQ(cat.wait(20s), 0) << cat.err();
+  for (const auto& p : parse_lines(cat.out())) EXPECT_EQ(p.at("state"), "no_hand");
+}
+
+struct BadConfig {
+  const char* toml;
+  std::vector<std::string> names;  // besides the file name
+};
+
+TEST_F(Handtrackd, BadConfigValuesAreRefusedWithFileFieldAndRange) {
+  const std::vector<BadConfig> cases = {
+      {"[tracker]\nparticles = 0\n", {"tracker.particles", "1..64"}},
+      {"[tracker.energy]\nw_c = -1.0\n", {"tracker.energy.w_c", "0.0..1000.0"}},
+      {"[tracker.optimizer]\niterations = 100000\n", {"tracker.optimizer.iterations", "1..1000"}},
+      {"[tracker.input]\nnear_mm = 700.0\n", {"tracker.input.near_mm", "tracker.input.far_mm"}},
+      {"[tracker.input]\nquadtree_threshold_mm = \"twenty\"\n", {"tracker.input.quadtree_threshold_mm", "number"}},
+      {"[pipeline]\nrealtime_priority = 120\n", {"pipeline.realtime_priority", "0..99"}},
+      {"[daemon]\nlog_level = \"loud\"\n", {"daemon.log_level", "trace, debug"}},
+      {"[daemon]\nshm_name = \"a/b\"\n", {"daemon.shm_name", "without '/'"}},
+      {"[tracker]\nparticels = 2\n", {"unknown field", "tracker.particels"}},
+      {"[tracker\nparticles = 2\n", {":1:", "TOML syntax error"}},
+  };
+  int i = 0;
+  for (const auto& c : cases) {
+    const auto file = dir_ / ("bad" + std::to_string(i++) + ".toml");
+    std::ofstream(file) << c.toml;
+    auto names = c.names;
+    names.push_back(file.string());
+    SCOPED_TRACE(c.toml);
+    expect_one_line_error(run(daemon_args({"--config", file.string(), "--source", "synthetic"}), dir_, "d"), names);
+  }
+  expect_one_line_error(run(daemon_args({"--particles", "0", "--source", "synthetic"}), dir_, "cli"),
+                        {"tracker.particles", "1..64"});
+}
+
+TEST_F(Handtrackd, UnreadableOrMissingConfigIsAClearError) {
+  expect_one_line_error(run(daemon_args({"--config", (dir_ / "nope.toml").string()}), dir_, "missing"),
+                        {"nope.toml", "no such file"});
+  expect_one_line_error(run(daemon_args({"--config", dir_.path().string()}), dir_, "dir"), {"is a directory"});
+  const auto garbage = dir_ / "garbage.toml";
+  std::ofstream(garbage, std::ios::binary) << std::string("\x89PNG\r\n\x1a\n\0\0\xff\xfe", 12);
+  expect_one_line_error(run(daemon_args({"--config", garbage.string()}), dir_, "garbage"), {"garbage.toml"});
+  if (geteuid() != 0) {  // root reads any file
+    const auto locked = dir_ / "locked.toml";
+    std::ofstream(locked) << "[tracker]\nparticles = 2\n";
+    fs::permissions(locked, fs::perms::none);
+    expect_one_line_error(run(daemon_args({"--config", locked.string()}), dir_, "locked"), {"locked.toml", "cannot read"});
+  }
+}
+
+TEST_F(Handtrackd, UnknownSourceIsAClearError) {
+  expect_one_line_error(run(daemon_args({"--source", "webcam"}), dir_, "d1"), {"webcam", "unknown source"});
+  expect_one_line_error(run(daemon_args({"--source", "synthetic:juggle"}), dir_, "d2"), {"juggle", "unknown motion"});
+}
+
+}  // namespace
+}  // namespace handtrack::test

@@ -1,0 +1,199 @@
+// The pipeline in-process, with scripted sources: a resolution change mid-stream (buffers rebuilt,
+// tracking resumes at the new resolution), frames with no depth in the working volume (no_hand,
+// counted), and the newest-frame-wins policy of a live source whose frames come faster than the
+// optimizer can take them (drops counted, poses stay fresh, every frame accounted for).
+#include "handtrack/daemon/pipeline.hpp"
+#include "handtrack/daemon/synthetic_source.hpp"
+#include "handtrack/ipc/pose_ring_reader.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <functional>
+#include <thread>
+
+namespace handtrack::daemon {
+namespace {
+
+using namespace std::chrono_literals;
+
+int64_t now_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// Frames from a function, as a recording (lossless with fast) or as a live camera.
+class ScriptedSource final : public DepthSource {
+ public:
+  using Render = std::function<void(uint64_t, RawFrame&)>;
+  ScriptedSource(uint64_t frames, bool live, Render render) : frames_(frames), live_(live), render_(std::move(render)) {}
+  [[nodiscard]] std::string describe() const override { return "scripted"; }
+  bool open(std::string*) override { return true; }
+  void close() override {}
+  GrabStatus grab(RawFrame& frame, std::chrono::milliseconds) override {
+    if (next_ >= frames_) return GrabStatus::kEndOfStream;
+    render_(next_, frame);
+    frame.frame_number = next_++;
+    frame.capture_ns = now_ns();
+    return GrabStatus::kFrame;
+  }
+  [[nodiscard]] CameraIntrinsics camera() const override { return synth::default_camera(); }
+  [[nodiscard]] bool is_live() const override { return live_; }
+
+ private:
+  uint64_t frames_;
+  bool live_;
+  Render render_;
+  uint64_t next_ = 0;
+};
+
+void to_raw(const DepthImage& depth, RawFrame& frame) {
+  frame.camera = depth.camera;
+  frame.depth_raw.resize(depth.depth_mm.size());
+  for (size_t i = 0; i < depth.depth_mm.size(); ++i) {
+    const float d = depth.depth_mm[i];
+    frame.depth_raw[i] = d > 0.0F ? static_cast<uint16_t>(std::lround(std::min(d, 65535.0F))) : uint16_t{0};
+  }
+}
+
+struct Ring {
+  std::string name = "htd-pipeline-test-" + std::to_string(getpid());
+  ipc::PoseRingWriter writer{ipc::PoseRingWriter::Options{.name = name, .capacity = 1024}};
+  ~Ring() { ipc::PoseRingWriter::remove(name); }
+};
+
+std::vector<ipc::PoseRecord> run_to_end(Pipeline& pipeline, ipc::PoseRingReader& reader) {
+  std::string why;
+  EXPECT_TRUE(pipeline.start(&why)) << why;
+  std::vector<ipc::PoseRecord> records;
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  ipc::PoseRecord r{};
+  while (!pipeline.finished() && std::chrono::steady_clock::now() < deadline) {
+    while (reader.wait_next(r, 20ms) == HANDTRACK_OK) records.push_back(r);
+  }
+  EXPECT_TRUE(pipeline.finished()) << "did not finish in time";
+  while (reader.try_next(r) == HANDTRACK_OK) records.push_back(r);
+  pipeline.stop();
+  pipeline.join();
+  return records;
+}
+
+double fingertip_error_mm(const ipc::PoseRecord& r, const Fingertips& truth) {
+  double sum = 0.0;
+  for (int f = 0; f < kNumFingers; ++f) {
+    const Eigen::Vector3d got(r.fingertips_mm[f][0], r.fingertips_mm[f][1], r.fingertips_mm[f][2]);
+    sum += (got - *truth[static_cast<size_t>(f)]).norm();
+  }
+  return sum / kNumFingers;
+}
+
+TEST(Pipeline, ResolutionChangeMidStreamRebuildsBuffersAndKeepsTracking) {
+  constexpr uint64_t kFrames = 80;
+  synth::SyntheticCamera small(synthetic_camera_options("pinch", SourceOptions{}));
+  auto big_options = synthetic_camera_options("pinch", SourceOptions{});
+  big_options.camera = synth::default_camera(640, 480);
+  synth::SyntheticCamera big(big_options);
+  synth::SynthFrame rendered;
+  auto source = std::make_unique<ScriptedSource>(kFrames, false, [&](uint64_t i, RawFrame& f) {
+    (i < kFrames / 2 ? small : big).render(static_cast<int>(i), rendered);
+    to_raw(rendered.depth, f);
+  });
+  DaemonConfig config;
+  config.fast = true;  // lossless: every frame is tracked
+  Ring ring;
+  ipc::PoseRingReader reader;
+  ASSERT_EQ(reader.open(ring.name), HANDTRACK_OK);
+  Pipeline pipeline(config, std::move(source), ring.writer);
+  const auto records = run_to_end(pipeline, reader);
+  const auto c = pipeline.counters();
+  EXPECT_EQ(c.resolution_changes, 1U);
+  EXPECT_EQ(c.frames_published, kFrames);
+  ASSERT_EQ(records.size(), kFrames);
+  // Tracking at 640x480 after the change: the last 20 frames fit the ground truth.
+  double error = 0.0;
+  for (uint64_t i = kFrames - 20; i < kFrames; ++i) {
+    EXPECT_EQ(records[i].frame, i);
+    error += fingertip_error_mm(records[i], big.render(static_cast<int>(i)).fingertips) / 20.0;
+  }
+  EXPECT_LT(error, 40.0);
+}
+
+TEST(Pipeline, FramesWithoutDepthInTheWorkingVolumeAreNoHandAndCounted) {
+  constexpr uint64_t kFrames = 30;
+  auto source = std::make_unique<ScriptedSource>(kFrames, false, [](uint64_t i, RawFrame& f) {
+    f.camera = synth::default_camera();
+    // all zero (no measurement), all at the sensor's maximum, all just beyond the far plane
+    const uint16_t value = i % 3 == 0 ? 0 : i % 3 == 1 ? 65535 : 601;
+    f.depth_raw.assign(static_cast<size_t>(f.camera.width * f.camera.height), value);
+  });
+  DaemonConfig config;
+  config.fast = true;
+  Ring ring;
+  ipc::PoseRingReader reader;
+  ASSERT_EQ(reader.open(ring.name), HANDTRACK_OK);
+  Pipeline pipeline(config, std::move(source), ring.writer);
+  const auto records = run_to_end(pipeline, reader);
+  EXPECT_EQ(pipeline.counters().frames_empty, kFrames);
+  ASSERT_EQ(records.size(), kFrames);
+  for (const auto& r : records) {
+    EXPECT_EQ(r.state, HANDTRACK_STATE_NO_HAND);
+    EXPECT_EQ(r.confidence, 0.0F);
+  }
+}
+
+TEST(Pipeline, MalformedFramesAreSkippedNotPublished) {
+  auto source = std::make_unique<ScriptedSource>(10, false, [](uint64_t i, RawFrame& f) {
+    f.camera = synth::default_camera();
+    f.depth_raw.assign(static_cast<size_t>(f.camera.width * f.camera.height) - (i % 2), 0);  // odd: one short
+  });
+  DaemonConfig config;
+  config.fast = true;
+  Ring ring;
+  ipc::PoseRingReader reader;
+  ASSERT_EQ(reader.open(ring.name), HANDTRACK_OK);
+  Pipeline pipeline(config, std::move(source), ring.writer);
+  const auto records = run_to_end(pipeline, reader);
+  EXPECT_EQ(pipeline.counters().frames_skipped, 5U);
+  EXPECT_EQ(records.size(), 5U);
+}
+
+TEST(Pipeline, LiveSourceFasterThanTheOptimizerDropsOldestFramesAndStaysFresh) {
+  constexpr uint64_t kFrames = 150;
+  synth::SyntheticCamera camera(synthetic_camera_options("pinch", SourceOptions{}));
+  synth::SynthFrame rendered;
+  // A "camera" delivering frames as fast as it can render them (~3 ms), faster than tracking.
+  auto source = std::make_unique<ScriptedSource>(kFrames, true, [&](uint64_t i, RawFrame& f) {
+    camera.render(static_cast<int>(i), rendered);
+    to_raw(rendered.depth, f);
+  });
+  DaemonConfig config;
+  config.max_frames = kFrames;
+  Ring ring;
+  ipc::PoseRingReader reader;
+  ASSERT_EQ(reader.open(ring.name), HANDTRACK_OK);
+  Pipeline pipeline(config, std::move(source), ring.writer);
+  const auto records = run_to_end(pipeline, reader);
+  const auto c = pipeline.counters();
+  EXPECT_EQ(c.frames_captured, kFrames);
+  EXPECT_GT(c.frames_dropped, 0U) << "the optimizer kept up with a ~300 fps source?";
+  EXPECT_EQ(c.frames_published + c.frames_dropped + c.frames_skipped, c.frames_captured);
+  ASSERT_EQ(records.size(), c.frames_published);
+  std::vector<double> age_ms;
+  for (size_t i = 0; i < records.size(); ++i) {
+    if (i > 0) {
+      EXPECT_GT(records[i].frame, records[i - 1].frame) << "published out of order";
+    }
+    age_ms.push_back(static_cast<double>(records[i].publish_ns - records[i].capture_ns) * 1e-6);
+  }
+  std::sort(age_ms.begin(), age_ms.end());
+  // Newest wins: a pose is at most a couple of frame times old, not a queue's worth.
+  const double p50 = age_ms[age_ms.size() / 2];
+  std::printf("live overload: %zu published, %llu dropped, age p50 %.1f ms, max %.1f ms\n", records.size(),
+              static_cast<unsigned long long>(c.frames_dropped), p50, age_ms.back());
+  EXPECT_LT(p50, 150.0);
+}
+
+}  // namespace
+}  // namespace handtrack::daemon
