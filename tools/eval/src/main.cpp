@@ -64,7 +64,9 @@ int main(int argc, char** argv) {
   app.add_option("--iterations", config.optimizer.iterations, "optimizer iterations per particle")
       ->check(CLI::Range(1, 1000));
   app.add_option("--seed", config.seed, "random seed of the particle extrapolation");
-  app.add_flag("--no-collision{0}", config.weights.collision, "E_sim only: drop E_col (ablation)");
+  app.add_option("--w-col", config.weights.collision, "w_c, weight of E_col (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
+  app.add_option("--w-lim", config.weights.limits, "w_l, weight of E_lim (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
+  app.add_option("--w-smo", config.weights.smoothness, "w_s, weight of E_smo (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
   bool sim_only = false;
   app.add_flag("--sim-only", sim_only, "E_sim only: drop E_col, E_lim and E_smo (ablation of Fig. 6)");
   try {
