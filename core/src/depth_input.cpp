@@ -21,6 +21,12 @@ constexpr double kHandRadiusInLengths = 1.0;
 constexpr double kHandLengthMargin = 1.1;
 // The forearm is cut this far below the wrist joint (mm): the wrist's own surface stays in.
 constexpr double kWristCutMarginMm = 10.0;
+// A blob whose outline runs along the far plane of the working volume for more than this share
+// is a larger surface (a shoulder, a desk) reaching into the volume, not a hand in front of one.
+// Measured: synthetic hands with their forearms 0-0.10, the shoulder of the .oni recording
+// 0.18-0.24; a real hand straddling the far plane (SR305 231615/100: 0.25) is missed until it
+// comes nearer, which is what a working volume means.
+constexpr double kMaxFarPlaneCut = 0.15;
 // Pixels this close to the image border mark the end of a blob where the arm leaves the image.
 constexpr int kBorderPx = 3;
 
@@ -77,6 +83,7 @@ void DepthInputBuilder::median_filter(const DepthImage& depth) {
   const int h = depth.height();
   const int r = config_.median_radius_px;
   out_.filtered_mm.assign(depth.depth_mm.size(), 0.0F);
+  unclamped_mm_.assign(depth.depth_mm.size(), 0.0F);
   const auto near = static_cast<float>(config_.near_mm);
   const auto far = static_cast<float>(config_.far_mm);
   for (int v = 0; v < h; ++v) {
@@ -94,6 +101,7 @@ void DepthInputBuilder::median_filter(const DepthImage& depth) {
       std::nth_element(window_.begin(), mid, window_.end());
       const float m = *mid;
       out_.filtered_mm[static_cast<size_t>(v) * w + u] = (m >= near && m <= far) ? m : 0.0F;
+      unclamped_mm_[static_cast<size_t>(v) * w + u] = m;
     }
   }
 }
@@ -271,6 +279,7 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
     // The wrist sits about half a palm (a quarter of the hand length) below the palm centre.
     wrist = centre - axis * (0.25 * length);
     count = select();
+    if (far_plane_cut_fraction(best) > kMaxFarPlaneCut) count = 0;
   }
   out_.hand_pixels = count;
   out_.finger_axis = axis;
@@ -284,6 +293,34 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
     std::fill(out_.hand_mask.begin(), out_.hand_mask.end(), 0);
     out_.hand_pixels = 0;
   }
+}
+
+double DepthInputBuilder::far_plane_cut_fraction(int blob) const {
+  const int w = out_.camera.width;
+  const int h = out_.camera.height;
+  const auto far = static_cast<float>(config_.far_mm);
+  const auto reach = static_cast<float>(config_.far_mm + config_.continuity_mm);
+  int boundary = 0;
+  int continued = 0;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      if (component_[static_cast<size_t>(v) * w + u] != blob) continue;
+      bool edge = false;
+      bool beyond = false;
+      for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+        const int uu = u + du;
+        const int vv = v + dv;
+        if (uu < 0 || vv < 0 || uu >= w || vv >= h) continue;
+        const auto j = static_cast<size_t>(vv) * w + uu;
+        if (component_[j] == blob) continue;
+        edge = true;
+        beyond = beyond || (unclamped_mm_[j] > far && unclamped_mm_[j] <= reach);
+      }
+      boundary += edge ? 1 : 0;
+      continued += beyond ? 1 : 0;
+    }
+  }
+  return boundary > 0 ? static_cast<double>(continued) / boundary : 0.0;
 }
 
 void DepthInputBuilder::build_quadtree() {

@@ -139,7 +139,7 @@ double PoseTracker::confidence(const DepthInput& input, const PosedHand& hand) c
 }
 
 TrackerOutput PoseTracker::optimise(const DepthInput& input) {
-  if (!input.has_hand()) {
+  const auto no_hand = [&]() {
     reset();
     recovering_ = true;
     TrackerOutput none;  // no pose is invented: everything zero
@@ -147,7 +147,8 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     none.joints.fill(Vector3d::Zero());
     none.fingertips.fill(Vector3d::Zero());
     return none;
-  }
+  };
+  if (!input.has_hand()) return no_hand();
   EnergyFrame frame{&model_, &input, nullptr, nullptr};
   // (Re)start: the open hand at the segmented hand, a few in-plane rotations, the best energy wins.
   // The hypotheses are compared by confidence, not energy: E_sim has no notion of occlusion, so
@@ -178,8 +179,10 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   const bool labelled = std::any_of(input.gaussians.begin(), input.gaussians.end(),
                                     [](const ImageGaussian& g) { return g.label != kBackground; });
   const bool fuse = config_.mode == EnergyMode::kLateFusion && labelled;
+  bool started = false;
   if (!previous_) {
     best = start();
+    started = true;
     recovering_ = true;
   } else {
     frame.previous = &*previous_;
@@ -210,6 +213,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     // The fit is clearly wrong: start again from the open hand on this very frame.
     frame.previous = frame.before_previous = nullptr;
     best = start();
+    started = true;
     winner = -1;
     guided_won = false;
     scratch_.update(model_, best.params);
@@ -220,6 +224,9 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   } else if (conf >= config_.lost_confidence) {
     recovering_ = false;
   }
+  // What the hand model cannot explain from any start is not a hand (a shoulder or a desk edge
+  // reaching into the working volume): report no hand rather than invent a pose.
+  if (started && conf < config_.min_start_confidence) return no_hand();
   before_previous_ = previous_;
   previous_ = best.params;
   auto out = describe(best.params, best.energy, input, recovering_ ? TrackingState::kRecovering : TrackingState::kTracking);

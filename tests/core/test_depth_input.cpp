@@ -121,6 +121,21 @@ TEST(DepthInput, NothingInsideTheWorkingVolumeMeansNoHand) {
   EXPECT_FALSE(builder.build(nan, std::nullopt).has_hand());
 }
 
+TEST(DepthInput, ASurfaceReachingIntoTheVolumeIsNotAHand) {
+  // A shoulder-like slanted surface from 540 mm at the left edge to 900 mm: its part inside the
+  // working volume is hand-sized but its outline runs along the far plane.
+  const auto cam = camera(320, 240);
+  DepthImage img{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 0.0F)};
+  for (int v = 40; v < 200; ++v) {
+    for (int u = 0; u < 160; ++u) img.at(u, v) = static_cast<float>(540.0 + 2.5 * u);
+  }
+  DepthInputBuilder builder;
+  EXPECT_FALSE(builder.build(img, std::nullopt).has_hand());
+  // The same blob in front of a body well behind the far plane is taken.
+  DepthInputBuilder fresh;
+  EXPECT_TRUE(fresh.build(blob_scene(cam, 560, false), std::nullopt).has_hand());
+}
+
 TEST(DepthInput, MedianFilterRemovesFlyingPixels) {
   const auto cam = camera(320, 240);
   DepthImage img = blob_scene(cam, 400, false);

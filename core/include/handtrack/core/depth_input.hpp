@@ -94,6 +94,8 @@ class DepthInputBuilder {
   void median_filter(const DepthImage& depth);
   void segment(const std::optional<HandHint>& hint);
   void build_quadtree();
+  // Share of a connected surface's outline where it goes on just beyond the far plane.
+  [[nodiscard]] double far_plane_cut_fraction(int blob) const;
   void quad(int x, int y, int side, int min_leaf);
 
   DepthInputConfig config_;
@@ -101,6 +103,7 @@ class DepthInputBuilder {
   std::vector<int> component_;
   std::vector<int> stack_;
   std::vector<float> window_;
+  std::vector<float> unclamped_mm_;  // median-filtered depth before the working volume
 };
 
 // E(C_a, C_b) of paper eq. 3 for two sets of image-plane Gaussians.

@@ -43,6 +43,8 @@ struct TrackerConfig {
   int init_iterations = 40;          // iterations for a (re)start from the open hand
   double lost_confidence = 0.3;      // below this for `lost_frames` frames in a row: restart
   int lost_frames = 3;
+  // A (re)start must explain at least this much of the segmented surface, or there is no hand.
+  double min_start_confidence = 0.6;
   uint64_t seed = 1;
 };
 

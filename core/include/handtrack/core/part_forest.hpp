@@ -1,0 +1,167 @@
+#pragma once
+// The hand-part classification forest of Sec. 4.3: a randomized decision forest that labels every
+// segmented hand pixel with one of the 12 parts (or background), using the depth-comparison
+// features of Shotton et al. 2011 ("Real-time human pose recognition in parts from single depth
+// images", CVPR 2011, eq. 1):
+//
+//   f_theta(I, x) = d_I(x + u / d_I(x)) - d_I(x + v / d_I(x)),   theta = (u, v)
+//
+// The offsets u, v are in pixel * mm at the model's reference focal length (fx_ref, fy_ref), so
+// they cover the same metric distance at any depth and, scaled by fx / fx_ref and fy / fy_ref at
+// run time, at any resolution. A probe outside the image or off the hand mask reads the model's
+// constant background depth (a "large positive constant" in Shotton et al.).
+// A pixel goes left when f < threshold. Its class distribution is the mean of the trees' leaf
+// distributions (Criminisi and Shotton 2013); the label is the argmax.
+//
+// Model file (little-endian; written by save(), read by load()), format version 1:
+//
+//   offset  size  field
+//        0     8  magic "HTFOREST"
+//        8     4  u32 format version (kFormatVersion)
+//       12     4  u32 classes (must be kPartForestClasses = 13: background + 12 parts)
+//       16     4  u32 trees T (1..kMaxTrees)
+//       20     4  f32 reference fx (pixels)
+//       24     4  f32 reference fy (pixels)
+//       28     4  f32 background depth (mm) read by probes off the hand
+//       32     4  u32 metadata length M (<= kMaxMetadataBytes)
+//       36     M  metadata: UTF-8 text, training command and statistics
+//     ...  8 T  per tree: u32 node count N_t, u32 leaf count L_t
+//     ...        per tree: N_t nodes of 16 bytes
+//                            i16 u_x, u_y, v_x, v_y  (pixel * mm at the reference focal length)
+//                            f32 threshold (mm)
+//                            u32 child: internal node: index of the left child within the tree,
+//                                the right child is the next node, both after this one;
+//                                leaf: kLeafBit | leaf index
+//                          then L_t leaves of 13 x u16: class probabilities * 65535 (sum > 0)
+//     end-8    8  u64 FNV-1a 64 of every byte before it
+//
+// Only the nodes that exist are stored (the paper's full trees took 1 GB).
+// @thread A loaded PartForest is immutable: label() may be called from several threads at once.
+
+#include "handtrack/core/depth_input.hpp"
+#include "handtrack/core/hand_layout.hpp"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace handtrack {
+
+inline constexpr int kPartForestClasses = kNumPartLabels + 1;  // background (0) + the 12 parts
+
+struct PartForestNode {
+  static constexpr uint32_t kLeafBit = 0x8000'0000U;
+  std::array<int16_t, 2> u{};  // probe offsets (x, y), pixel * mm at the reference focal length
+  std::array<int16_t, 2> v{};
+  float threshold = 0.0F;  // mm: f < threshold goes to the left child
+  uint32_t child = kLeafBit;
+
+  [[nodiscard]] bool is_leaf() const { return (child & kLeafBit) != 0; }
+  [[nodiscard]] uint32_t leaf_index() const { return child & ~kLeafBit; }
+};
+static_assert(sizeof(PartForestNode) == 16, "nodes are stored as 16 bytes, in memory as in the file");
+
+// Class probabilities of a leaf, each scaled to 0..65535.
+using PartForestLeaf = std::array<uint16_t, kPartForestClasses>;
+
+struct PartForestTree {
+  std::vector<PartForestNode> nodes;  // nodes[0] is the root
+  std::vector<PartForestLeaf> leaves;
+};
+
+struct PartForestInfo {
+  float reference_fx = 224.502F;  // focal lengths the offsets were trained at (SPEC.md camera)
+  float reference_fy = 230.494F;
+  float background_mm = 4000.0F;  // depth read by probes outside the image or off the hand
+  std::string metadata;           // free text: how the model was trained
+};
+
+struct PartForestOptions {
+  // Classify every stride-th pixel in x and y (per 320 pixels of image width: 2 at 640x480 when
+  // 1 here); the other hand pixels of each stride x stride block take that block's label.
+  int stride_px = 1;
+};
+
+// Probe arithmetic, shared by training and inference so that both round alike, in 16.16 fixed
+// point (integer multiply and shift: shorter latency than float conversions on the descent's
+// critical path). The scale of pixel x is k = round(65536 (f / f_ref) / d(x)), at most 2^22;
+// a probe reads pixel x + round(offset k / 65536) (halves rounded up).
+inline constexpr int kProbeScaleBits = 16;
+inline int32_t probe_scale(double focal_ratio, float depth_mm) {
+  constexpr double kMax = 4194304.0;  // 2^22: |offset k| >> 16 stays below 2^21 pixels
+  const double k = focal_ratio / static_cast<double>(depth_mm) * 65536.0;
+  return static_cast<int32_t>(std::lround(std::isfinite(k) ? std::fmin(std::fmax(k, 0.0), kMax) : kMax));
+}
+inline int probe_coordinate(int x, int16_t offset, int32_t scale) {
+  return x + static_cast<int>((int64_t{offset} * scale + (int64_t{1} << (kProbeScaleBits - 1))) >> kProbeScaleBits);
+}
+
+class PartForest final : public PixelLabeller {
+ public:
+  static constexpr uint32_t kFormatVersion = 1;
+  static constexpr int kMaxTrees = 64;
+  static constexpr uint32_t kMaxMetadataBytes = 1U << 16;
+  static constexpr uint32_t kMaxNodesPerTree = 1U << 26;
+
+  // Validates the trees (children after their parent and in range, leaf indices in range, finite
+  // thresholds, leaves with some probability, positive finite focal lengths and background);
+  // throws std::invalid_argument naming the first problem.
+  PartForest(std::vector<PartForestTree> trees, PartForestInfo info, PartForestOptions options = {});
+
+  // Reads a model file. Throws std::runtime_error with one line "part forest FILE: what is wrong"
+  // (cannot open, truncated, bad magic, unsupported version, checksum mismatch, node index out of
+  // range, bad leaf, ...). Never crashes, whatever the bytes.
+  static PartForest load(const std::filesystem::path& path, PartForestOptions options = {});
+  // The same from bytes in memory; `name` stands for the file in messages.
+  static PartForest from_bytes(std::span<const uint8_t> bytes, const std::string& name,
+                               PartForestOptions options = {});
+  // Writes the model file (throws std::runtime_error naming the file when it cannot).
+  void save(const std::filesystem::path& path) const;
+  [[nodiscard]] std::vector<uint8_t> to_bytes() const;
+
+  // PixelLabeller: labels (resized to the image) get the argmax class of every hand-mask pixel,
+  // 0 elsewhere. No allocation once `labels` has the image's size.
+  void label(const DepthInput& input, std::vector<uint8_t>& labels) const override;
+
+  // Mean of the trees' leaf distributions at pixel (x, y) of the input, which must be on the hand
+  // mask (probabilities summing to ~1).
+  [[nodiscard]] std::array<float, kPartForestClasses> distribution(const DepthInput& input, int x, int y) const;
+
+  [[nodiscard]] const std::vector<PartForestTree>& trees() const { return trees_; }
+  [[nodiscard]] const PartForestInfo& info() const { return info_; }
+  [[nodiscard]] const PartForestOptions& options() const { return options_; }
+  void set_options(const PartForestOptions& options);
+  [[nodiscard]] size_t node_count() const;
+  [[nodiscard]] int max_depth() const;
+
+ private:
+  template <typename Accumulate>
+  void descend(const DepthInput& input, int x, int y, Accumulate&& accumulate) const;
+  static constexpr int kBatch = 64;  // pixels classified together (lockstep descent)
+  struct Site {
+    int x = 0;  // the pixel classified
+    int y = 0;
+    int block_x = 0;  // its stride x stride block
+    int block_y = 0;
+  };
+  struct Crop {
+    const float* depth_mm = nullptr;  // width x height: the hand's depth, the background elsewhere
+    int x0 = 0;                       // its top-left pixel in the image
+    int y0 = 0;
+    int width = 0;
+    int height = 0;
+    double focal_ratio_x = 1.0;  // fx / fx_ref
+    double focal_ratio_y = 1.0;
+  };
+  void classify_batch(const Crop& crop, const Site* sites, int count, uint8_t* out) const;
+
+  std::vector<PartForestTree> trees_;
+  PartForestInfo info_;
+  PartForestOptions options_;
+};
+
+}  // namespace handtrack

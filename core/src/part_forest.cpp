@@ -1,0 +1,501 @@
+#include "handtrack/core/part_forest.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+#include <string_view>
+
+namespace handtrack {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the model file is read by memcpy: little-endian only");
+
+constexpr std::array<char, 8> kMagic = {'H', 'T', 'F', 'O', 'R', 'E', 'S', 'T'};
+constexpr size_t kFixedHeaderBytes = 36;  // magic .. metadata length
+constexpr size_t kChecksumBytes = 8;
+constexpr size_t kNodeBytes = 16;
+constexpr size_t kLeafBytes = 2 * kPartForestClasses;
+
+// FNV-1a 64 (Fowler, Noll, Vo): offset basis and prime of the 64-bit variant.
+constexpr uint64_t kFnvOffsetBasis = 0xcbf29ce484222325ULL;
+constexpr uint64_t kFnvPrime = 0x100000001b3ULL;
+
+uint64_t fnv1a64(std::span<const uint8_t> bytes) {
+  uint64_t h = kFnvOffsetBasis;
+  for (const uint8_t b : bytes) {
+    h ^= b;
+    h *= kFnvPrime;
+  }
+  return h;
+}
+
+// Bounds-checked little-endian reads; a short read throws "truncated".
+class Reader {
+ public:
+  explicit Reader(std::span<const uint8_t> bytes) : bytes_(bytes) {}
+
+  template <typename T>
+  T read(std::string_view what) {
+    T value;
+    need(sizeof(T), what);
+    std::memcpy(&value, bytes_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return value;
+  }
+  void read_bytes(void* out, size_t n, std::string_view what) {
+    need(n, what);
+    if (n > 0) std::memcpy(out, bytes_.data() + pos_, n);
+    pos_ += n;
+  }
+  void need(size_t n, std::string_view what) const {
+    if (n > bytes_.size() - pos_) {
+      throw std::runtime_error("truncated: " + std::string(what) + " needs " + std::to_string(n) +
+                               " bytes at offset " + std::to_string(pos_) + ", the file has " +
+                               std::to_string(bytes_.size()));
+    }
+  }
+  [[nodiscard]] size_t pos() const { return pos_; }
+
+ private:
+  std::span<const uint8_t> bytes_;
+  size_t pos_ = 0;
+};
+
+// Little-endian writes into a buffer sized up front (GCC 12 warns spuriously about a growing one).
+class Writer {
+ public:
+  explicit Writer(size_t size) : bytes_(size) {}
+  template <typename T>
+  void put(const T& value) {
+    put_bytes(&value, sizeof(T));
+  }
+  void put_bytes(const void* p, size_t n) {
+    if (n == 0) return;
+    if (n > bytes_.size() - pos_) throw std::logic_error("part forest: serialised size miscounted");
+    std::memcpy(bytes_.data() + pos_, p, n);
+    pos_ += n;
+  }
+  [[nodiscard]] size_t pos() const { return pos_; }
+  std::vector<uint8_t>& bytes() { return bytes_; }
+
+ private:
+  std::vector<uint8_t> bytes_;
+  size_t pos_ = 0;
+};
+
+std::string validate(const std::vector<PartForestTree>& trees, const PartForestInfo& info) {
+  if (trees.empty()) return "no trees";
+  if (trees.size() > static_cast<size_t>(PartForest::kMaxTrees)) return "too many trees: " + std::to_string(trees.size());
+  const auto positive = [](float f) { return std::isfinite(f) && f > 0.0F; };
+  if (!positive(info.reference_fx) || !positive(info.reference_fy)) return "bad reference focal length";
+  if (!positive(info.background_mm)) return "bad background depth";
+  if (info.metadata.size() > PartForest::kMaxMetadataBytes) return "metadata longer than 64 KiB";
+  for (size_t t = 0; t < trees.size(); ++t) {
+    const auto& nodes = trees[t].nodes;
+    const auto& leaves = trees[t].leaves;
+    const std::string where = "tree " + std::to_string(t);
+    if (nodes.empty()) return where + ": no nodes";
+    if (nodes.size() > PartForest::kMaxNodesPerTree) return where + ": too many nodes";
+    if (leaves.size() > nodes.size()) return where + ": more leaves than nodes";
+    for (size_t i = 0; i < nodes.size(); ++i) {
+      const PartForestNode& n = nodes[i];
+      const std::string node = where + " node " + std::to_string(i);
+      if (n.is_leaf()) {
+        if (n.leaf_index() >= leaves.size()) {
+          return node + ": leaf index " + std::to_string(n.leaf_index()) + " out of range (" +
+                 std::to_string(leaves.size()) + " leaves)";
+        }
+        continue;
+      }
+      // Children strictly after the parent: every path ends in a leaf within nodes.size() steps.
+      if (n.child <= i || n.child >= nodes.size() - 1) {
+        return node + ": child index " + std::to_string(n.child) + " out of range (" + std::to_string(nodes.size()) +
+               " nodes)";
+      }
+      if (!std::isfinite(n.threshold)) return node + ": threshold is not finite";
+    }
+    for (size_t l = 0; l < leaves.size(); ++l) {
+      uint32_t sum = 0;
+      for (const uint16_t p : leaves[l]) sum += p;
+      if (sum == 0) return where + " leaf " + std::to_string(l) + ": bad label distribution (all zero)";
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+PartForest::PartForest(std::vector<PartForestTree> trees, PartForestInfo info, PartForestOptions options)
+    : trees_(std::move(trees)), info_(std::move(info)) {
+  if (auto why = validate(trees_, info_); !why.empty()) throw std::invalid_argument("part forest: " + why);
+  set_options(options);
+}
+
+void PartForest::set_options(const PartForestOptions& options) {
+  if (options.stride_px < 1 || options.stride_px > 16) {
+    throw std::invalid_argument("part forest: stride must be 1..16, got " + std::to_string(options.stride_px));
+  }
+  options_ = options;
+}
+
+size_t PartForest::node_count() const {
+  size_t n = 0;
+  for (const auto& t : trees_) n += t.nodes.size();
+  return n;
+}
+
+int PartForest::max_depth() const {
+  int deepest = 0;
+  for (const auto& t : trees_) {
+    // Children come after their parent, so one forward pass settles every depth.
+    std::vector<int> depth(t.nodes.size(), 0);
+    for (size_t i = 0; i < t.nodes.size(); ++i) {
+      deepest = std::max(deepest, depth[i]);
+      if (t.nodes[i].is_leaf()) continue;
+      depth[t.nodes[i].child] = depth[i] + 1;
+      depth[t.nodes[i].child + 1] = depth[i] + 1;
+    }
+  }
+  return deepest;
+}
+
+std::vector<uint8_t> PartForest::to_bytes() const {
+  size_t size = kFixedHeaderBytes + info_.metadata.size() + 8 * trees_.size() + kChecksumBytes;
+  for (const auto& t : trees_) size += t.nodes.size() * kNodeBytes + t.leaves.size() * kLeafBytes;
+  Writer w(size);
+  w.put_bytes(kMagic.data(), kMagic.size());
+  w.put(kFormatVersion);
+  w.put(static_cast<uint32_t>(kPartForestClasses));
+  w.put(static_cast<uint32_t>(trees_.size()));
+  w.put(info_.reference_fx);
+  w.put(info_.reference_fy);
+  w.put(info_.background_mm);
+  w.put(static_cast<uint32_t>(info_.metadata.size()));
+  w.put_bytes(info_.metadata.data(), info_.metadata.size());
+  for (const auto& t : trees_) {
+    w.put(static_cast<uint32_t>(t.nodes.size()));
+    w.put(static_cast<uint32_t>(t.leaves.size()));
+  }
+  for (const auto& t : trees_) {
+    for (const auto& n : t.nodes) {
+      w.put(n.u[0]);
+      w.put(n.u[1]);
+      w.put(n.v[0]);
+      w.put(n.v[1]);
+      w.put(n.threshold);
+      w.put(n.child);
+    }
+    for (const auto& leaf : t.leaves) {
+      for (const uint16_t p : leaf) w.put(p);
+    }
+  }
+  const uint64_t checksum = fnv1a64(std::span<const uint8_t>(w.bytes().data(), w.pos()));
+  w.put(checksum);
+  return std::move(w.bytes());
+}
+
+void PartForest::save(const std::filesystem::path& path) const {
+  const std::vector<uint8_t> bytes = to_bytes();
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  if (!f) throw std::runtime_error("part forest " + path.string() + ": cannot open for writing");
+  f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  f.close();
+  if (!f) throw std::runtime_error("part forest " + path.string() + ": write failed");
+}
+
+PartForest PartForest::load(const std::filesystem::path& path, PartForestOptions options) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw std::runtime_error("part forest " + path.string() + ": cannot open");
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  if (f.bad()) throw std::runtime_error("part forest " + path.string() + ": read error");
+  return from_bytes(bytes, path.string(), options);
+}
+
+PartForest PartForest::from_bytes(std::span<const uint8_t> bytes, const std::string& name, PartForestOptions options) {
+  const auto fail = [&](const std::string& why) -> std::runtime_error {
+    return std::runtime_error("part forest " + name + ": " + why);
+  };
+  try {
+    Reader r(bytes);
+    std::array<char, 8> magic{};
+    r.read_bytes(magic.data(), magic.size(), "magic");
+    if (magic != kMagic) throw fail("bad magic (not a handtrack part forest file)");
+    const auto version = r.read<uint32_t>("format version");
+    if (version != kFormatVersion) {
+      throw fail("unsupported format version " + std::to_string(version) + " (this build reads " +
+                 std::to_string(kFormatVersion) + ")");
+    }
+    const auto classes = r.read<uint32_t>("class count");
+    if (classes != static_cast<uint32_t>(kPartForestClasses)) {
+      throw fail("bad class count " + std::to_string(classes) + " (expected " + std::to_string(kPartForestClasses) + ")");
+    }
+    const auto tree_count = r.read<uint32_t>("tree count");
+    if (tree_count == 0 || tree_count > static_cast<uint32_t>(kMaxTrees)) {
+      throw fail("bad tree count " + std::to_string(tree_count));
+    }
+    PartForestInfo info;
+    info.reference_fx = r.read<float>("reference fx");
+    info.reference_fy = r.read<float>("reference fy");
+    info.background_mm = r.read<float>("background depth");
+    const auto metadata_bytes = r.read<uint32_t>("metadata length");
+    if (metadata_bytes > kMaxMetadataBytes) throw fail("bad metadata length " + std::to_string(metadata_bytes));
+    info.metadata.resize(metadata_bytes);
+    r.read_bytes(info.metadata.data(), metadata_bytes, "metadata");
+    static_assert(kFixedHeaderBytes == 36);
+
+    std::vector<PartForestTree> trees(tree_count);
+    // Node and leaf counts per tree; storage is allocated only after the file size matched them.
+    std::vector<std::array<uint32_t, 2>> counts(tree_count);
+    uint64_t payload = 0;  // bytes of nodes and leaves; 64-bit so corrupt counts cannot wrap
+    for (uint32_t t = 0; t < tree_count; ++t) {
+      const auto nodes = r.read<uint32_t>("node count");
+      const auto leaves = r.read<uint32_t>("leaf count");
+      if (nodes == 0 || nodes > kMaxNodesPerTree) throw fail("tree " + std::to_string(t) + ": bad node count " + std::to_string(nodes));
+      if (leaves > nodes) throw fail("tree " + std::to_string(t) + ": bad leaf count " + std::to_string(leaves));
+      payload += uint64_t{nodes} * kNodeBytes + uint64_t{leaves} * kLeafBytes;
+      counts[t] = {nodes, leaves};
+    }
+    const uint64_t expected = uint64_t{r.pos()} + payload + kChecksumBytes;
+    if (bytes.size() < expected) {
+      throw fail("truncated: the header announces " + std::to_string(expected) + " bytes, the file has " +
+                 std::to_string(bytes.size()));
+    }
+    if (bytes.size() > expected) {
+      throw fail("trailing garbage: the header announces " + std::to_string(expected) + " bytes, the file has " +
+                 std::to_string(bytes.size()));
+    }
+    uint64_t stored = 0;
+    std::memcpy(&stored, bytes.data() + bytes.size() - kChecksumBytes, kChecksumBytes);
+    if (stored != fnv1a64(bytes.first(bytes.size() - kChecksumBytes))) throw fail("checksum mismatch (corrupt file)");
+
+    for (uint32_t t = 0; t < tree_count; ++t) {
+      trees[t].nodes.resize(counts[t][0]);
+      trees[t].leaves.resize(counts[t][1]);
+    }
+    for (auto& t : trees) {
+      for (auto& n : t.nodes) {
+        n.u[0] = r.read<int16_t>("node");
+        n.u[1] = r.read<int16_t>("node");
+        n.v[0] = r.read<int16_t>("node");
+        n.v[1] = r.read<int16_t>("node");
+        n.threshold = r.read<float>("node");
+        n.child = r.read<uint32_t>("node");
+      }
+      for (auto& leaf : t.leaves) {
+        for (auto& p : leaf) p = r.read<uint16_t>("leaf");
+      }
+    }
+    if (auto why = validate(trees, info); !why.empty()) throw fail(why);
+    return PartForest(std::move(trees), std::move(info), options);
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    if (what.rfind("part forest ", 0) == 0) throw;
+    throw fail(what);
+  } catch (const std::bad_alloc&) {
+    throw fail("out of memory");
+  }
+}
+
+template <typename Accumulate>
+void PartForest::descend(const DepthInput& input, int x, int y, Accumulate&& accumulate) const {
+  const int w = input.camera.width;
+  const int h = input.camera.height;
+  const float* depth = input.filtered_mm.data();
+  const uint8_t* mask = input.hand_mask.data();
+  const float background = info_.background_mm;
+  // d_I(p): the filtered depth on the hand mask, the background constant elsewhere.
+  const auto probe = [&](int px, int py) -> float {
+    if (static_cast<unsigned>(px) >= static_cast<unsigned>(w) || static_cast<unsigned>(py) >= static_cast<unsigned>(h)) {
+      return background;
+    }
+    const size_t i = static_cast<size_t>(py) * static_cast<size_t>(w) + static_cast<size_t>(px);
+    return mask[i] != 0 ? depth[i] : background;
+  };
+  const float d = depth[static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x)];
+  // Offsets u / d(x), scaled from the reference focal length to this camera's.
+  const int32_t kx = probe_scale(input.camera.fx / info_.reference_fx, d);
+  const int32_t ky = probe_scale(input.camera.fy / info_.reference_fy, d);
+  for (const PartForestTree& tree : trees_) {
+    const PartForestNode* nodes = tree.nodes.data();
+    uint32_t i = 0;
+    while (!nodes[i].is_leaf()) {
+      const PartForestNode& n = nodes[i];
+      const float a = probe(probe_coordinate(x, n.u[0], kx), probe_coordinate(y, n.u[1], ky));
+      const float b = probe(probe_coordinate(x, n.v[0], kx), probe_coordinate(y, n.v[1], ky));
+      i = n.child + ((a - b) < n.threshold ? 0U : 1U);
+    }
+    accumulate(tree.leaves[nodes[i].leaf_index()]);
+  }
+}
+
+std::array<float, kPartForestClasses> PartForest::distribution(const DepthInput& input, int x, int y) const {
+  std::array<float, kPartForestClasses> p{};
+  const float scale = 1.0F / (65535.0F * static_cast<float>(trees_.size()));
+  descend(input, x, y, [&](const PartForestLeaf& leaf) {
+    for (int c = 0; c < kPartForestClasses; ++c) p[static_cast<size_t>(c)] += scale * leaf[static_cast<size_t>(c)];
+  });
+  return p;
+}
+
+void PartForest::classify_batch(const Crop& crop, const Site* sites, int count, uint8_t* out) const {
+  const float* depth = crop.depth_mm;
+  const float background = info_.background_mm;
+  // d_I(p): the crop holds the hand's depth and the background constant everywhere else, so one
+  // bounds check (a conditional move, no branch: whether a probe lands on the hand is
+  // unpredictable) makes a probe.
+  const auto probe = [&](int px, int py) -> float {
+    const bool inside = static_cast<unsigned>(px) < static_cast<unsigned>(crop.width) &&
+                        static_cast<unsigned>(py) < static_cast<unsigned>(crop.height);
+    const size_t i = inside ? static_cast<size_t>(py) * static_cast<size_t>(crop.width) + static_cast<size_t>(px) : 0;
+    const float d = depth[i];
+    return inside ? d : background;
+  };
+  const double sx = crop.focal_ratio_x;
+  const double sy = crop.focal_ratio_y;
+  std::array<int32_t, kBatch> kx{};
+  std::array<int32_t, kBatch> ky{};
+  for (int p = 0; p < count; ++p) {
+    const float d = depth[static_cast<size_t>(sites[p].y - crop.y0) * static_cast<size_t>(crop.width) +
+                          static_cast<size_t>(sites[p].x - crop.x0)];
+    kx[static_cast<size_t>(p)] = probe_scale(sx, d);
+    ky[static_cast<size_t>(p)] = probe_scale(sy, d);
+  }
+  std::array<std::array<uint32_t, kPartForestClasses>, kBatch> sum{};
+  for (const PartForestTree& tree : trees_) {
+    const PartForestNode* nodes = tree.nodes.data();
+    // The pixels descend in lockstep: their node -> probe -> node chains are independent, so the
+    // CPU overlaps their memory and multiply latencies (one chain alone is latency bound).
+    std::array<uint32_t, kBatch> at{};
+    for (bool active = true; active;) {
+      active = false;
+      for (int p = 0; p < count; ++p) {
+        const auto q = static_cast<size_t>(p);
+        const PartForestNode& n = nodes[at[q]];
+        if (n.is_leaf()) continue;
+        active = true;
+        // Crop coordinates: x + round(offset k) shifts with the crop.
+        const int x = sites[p].x - crop.x0;
+        const int y = sites[p].y - crop.y0;
+        const float a = probe(probe_coordinate(x, n.u[0], kx[q]), probe_coordinate(y, n.u[1], ky[q]));
+        const float b = probe(probe_coordinate(x, n.v[0], kx[q]), probe_coordinate(y, n.v[1], ky[q]));
+        at[q] = n.child + ((a - b) < n.threshold ? 0U : 1U);
+        // The next node of this pixel is needed only after the other pixels' steps: fetch it now
+        // (deep nodes are cache misses, the descent's main cost).
+        __builtin_prefetch(nodes + at[q]);
+      }
+    }
+    for (int p = 0; p < count; ++p) {
+      const auto q = static_cast<size_t>(p);
+      const PartForestLeaf& leaf = tree.leaves[nodes[at[q]].leaf_index()];
+      for (size_t c = 0; c < leaf.size(); ++c) sum[q][c] += leaf[c];
+    }
+  }
+  for (int p = 0; p < count; ++p) {
+    const auto& s = sum[static_cast<size_t>(p)];
+    out[p] = static_cast<uint8_t>(std::max_element(s.begin(), s.end()) - s.begin());
+  }
+}
+
+void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) const {
+  const int w = input.camera.width;
+  const int h = input.camera.height;
+  const size_t n = static_cast<size_t>(std::max(0, w)) * static_cast<size_t>(std::max(0, h));
+  labels.assign(n, 0);
+  if (n == 0 || input.hand_mask.size() != n || input.filtered_mm.size() != n) return;
+  const auto* mask = input.hand_mask.data();
+  const auto at = [w](int x, int y) { return static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x); };
+  const auto usable = [&](size_t i) { return mask[i] != 0 && input.filtered_mm[i] > 0.0F; };
+  const int stride = options_.stride_px * std::max(1, w / 320);
+
+  // The hand's bounding box, copied with the background constant off the mask: probes then need
+  // one bounds check, and the crop is small enough to stay in cache. Storage is per thread and
+  // reused (no allocation once it has grown).
+  int x0 = w, y0 = h, x1 = -1, y1 = -1;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (!usable(at(x, y))) continue;
+      x0 = std::min(x0, x);
+      x1 = std::max(x1, x);
+      y0 = std::min(y0, y);
+      y1 = std::max(y1, y);
+    }
+  }
+  if (x1 < 0) return;
+  thread_local std::vector<float> crop_storage;
+  Crop crop;
+  crop.x0 = x0;
+  crop.y0 = y0;
+  crop.width = x1 - x0 + 1;
+  crop.height = y1 - y0 + 1;
+  crop.focal_ratio_x = input.camera.fx / info_.reference_fx;
+  crop.focal_ratio_y = input.camera.fy / info_.reference_fy;
+  crop_storage.resize(static_cast<size_t>(crop.width) * static_cast<size_t>(crop.height));
+  for (int y = y0; y <= y1; ++y) {
+    float* row = crop_storage.data() + static_cast<size_t>(y - y0) * static_cast<size_t>(crop.width);
+    for (int x = x0; x <= x1; ++x) row[x - x0] = usable(at(x, y)) ? input.filtered_mm[at(x, y)] : info_.background_mm;
+  }
+  crop.depth_mm = crop_storage.data();
+
+  // Sites are classified in batches; each then labels its stride x stride block's hand pixels.
+  std::array<Site, kBatch> sites{};
+  std::array<uint8_t, kBatch> classes{};
+  int pending = 0;
+  const auto flush = [&]() {
+    classify_batch(crop, sites.data(), pending, classes.data());
+    for (int p = 0; p < pending; ++p) {
+      const Site& s = sites[static_cast<size_t>(p)];
+      const uint8_t l = classes[static_cast<size_t>(p)];
+      if (stride == 1) {
+        labels[at(s.x, s.y)] = l;
+        continue;
+      }
+      for (int y = s.block_y; y < std::min(h, s.block_y + stride); ++y) {
+        for (int x = s.block_x; x < std::min(w, s.block_x + stride); ++x) {
+          if (usable(at(x, y))) labels[at(x, y)] = l;
+        }
+      }
+    }
+    pending = 0;
+  };
+  const auto add = [&](int x, int y, int bx, int by) {
+    sites[static_cast<size_t>(pending++)] = Site{x, y, bx, by};
+    if (pending == kBatch) flush();
+  };
+  if (stride == 1) {
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        if (usable(at(x, y))) add(x, y, x, y);
+      }
+    }
+  } else {
+    // One site per block: its centre when that is on the hand, else its first hand pixel.
+    for (int by = 0; by < h; by += stride) {
+      const int ye = std::min(h, by + stride);
+      for (int bx = 0; bx < w; bx += stride) {
+        const int xe = std::min(w, bx + stride);
+        int sx = std::min(bx + stride / 2, xe - 1);
+        int sy = std::min(by + stride / 2, ye - 1);
+        if (!usable(at(sx, sy))) {
+          sx = -1;
+          for (int y = by; y < ye && sx < 0; ++y) {
+            for (int x = bx; x < xe; ++x) {
+              if (usable(at(x, y))) {
+                sx = x;
+                sy = y;
+                break;
+              }
+            }
+          }
+          if (sx < 0) continue;
+        }
+        add(sx, sy, bx, by);
+      }
+    }
+  }
+  if (pending > 0) flush();
+}
+
+}  // namespace handtrack
