@@ -140,11 +140,13 @@ SynthFrame SyntheticCamera::render(int frame) {
   return out;
 }
 
-void SyntheticCamera::render(int frame, SynthFrame& out) {
+void SyntheticCamera::render(int frame, SynthFrame& out) { render_pose(state_->motion.pose(frame), frame, out); }
+
+void SyntheticCamera::render_pose(const HandPose& pose, int frame, SynthFrame& out) {
   State& s = *state_;
   const CameraIntrinsics& cam = s.options.camera;
   out.frame = frame;
-  out.pose = s.motion.pose(frame);
+  out.pose = pose;
   out.joints = camera_frame_joints(s.shape, out.pose);
   out.fingertips = fingertips_from_joints(out.joints);
 

@@ -72,6 +72,10 @@ class SyntheticCamera {
   // reusing its buffers: no allocation once `out` has the right size.
   void render(int frame, SynthFrame& out);
   [[nodiscard]] SynthFrame render(int frame);
+  // Renders an arbitrary pose (e.g. a random one within JointLimits, for training the part forest)
+  // with this camera's subject, background and noise; `frame` only seeds the noise. out.frame =
+  // frame, out.pose = pose.
+  void render_pose(const HandPose& pose, int frame, SynthFrame& out);
 
   // Pose and joints only (no image): cheap.
   [[nodiscard]] HandPose pose(int frame) const;

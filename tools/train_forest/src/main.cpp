@@ -1,0 +1,313 @@
+// handtrack-train-forest: trains the hand-part classification forest of Sec. 4.3 on labelled
+// synthetic renders (docs/FOREST.md), evaluates a model on held-out synthetic frames
+// (--evaluate), and labels real depth frames into colour PNGs (--apply).
+
+#include "handtrack/core/part_forest.hpp"
+#include "handtrack/core/png_io.hpp"
+#include "handtrack/draw/colormap.hpp"
+#include "handtrack/train_forest/forest_data.hpp"
+#include "handtrack/train_forest/trainer.hpp"
+
+#include <CLI/CLI.hpp>
+#include <time.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+namespace fs = std::filesystem;
+using namespace handtrack;
+
+namespace {
+
+constexpr const char* kProgram = "handtrack-train-forest";
+// Held-out data (never trained on): motion subjects from these synth seeds, random-pose scenes
+// from this data-set seed.
+constexpr uint64_t kHeldOutMotionSeed = 900001;
+constexpr uint64_t kHeldOutSceneSeed = 0xE7A1'0000'0000ULL;
+
+int fail(const std::string& message, int code = 1) {
+  std::cerr << kProgram << ": error: " << message << "\n";
+  return code;
+}
+
+// Progress and time left on stderr, only when it is a terminal.
+class Progress {
+ public:
+  Progress() : enabled_(isatty(STDERR_FILENO) != 0), start_(Clock::now()) {}
+  void restart() { start_ = Clock::now(); }
+  void update(const std::string& stage, double fraction) {
+    if (!enabled_) return;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
+    const double eta = fraction > 0.0 ? elapsed / fraction * (1.0 - fraction) : 0.0;
+    std::fprintf(stderr, "\r%s: %s %3.0f%%, %.0f s left    ", kProgram, stage.c_str(), 100.0 * fraction, eta);
+    std::fflush(stderr);
+  }
+  void done() {
+    if (enabled_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  bool enabled_;
+  Clock::time_point start_;
+};
+
+// CPU time of the calling thread: label() timings that other processes on the machine disturb less.
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string percent(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f %%", 100.0 * x);
+  return buf;
+}
+
+struct EvalSummary {
+  forest::HeldOutResult motions;
+  forest::Confusion scenes;
+  double ms_per_frame = 0.0;
+  double hand_pixels = 0.0;  // mean per timed frame
+};
+
+EvalSummary evaluate(const PartForest& model, int frames_per_motion, int scenes) {
+  EvalSummary s;
+  s.motions = forest::evaluate_motions(model, kHeldOutMotionSeed, frames_per_motion);
+  s.scenes = forest::evaluate_scenes(model, kHeldOutSceneSeed, scenes, forest::SceneOptions{});
+  // Labelling time alone, on the held-out motion frames' inputs.
+  DepthInputBuilder builder;
+  synth::SynthOptions options;
+  options.motion = "random";
+  options.frames = 241;
+  options.seed = kHeldOutMotionSeed;
+  synth::SyntheticCamera cam(options);
+  std::vector<uint8_t> labels;
+  double total = 0.0;
+  double pixels = 0.0;
+  constexpr int kTimedFrames = 40;
+  constexpr int kRepeats = 5;
+  for (int i = 0; i < kTimedFrames; ++i) {
+    const DepthInput& in = builder.build(cam.render(i * 6).depth, std::nullopt);
+    const double t0 = thread_cpu_seconds();
+    for (int r = 0; r < kRepeats; ++r) model.label(in, labels);
+    total += thread_cpu_seconds() - t0;
+    pixels += in.hand_pixels;
+  }
+  s.ms_per_frame = 1000.0 * total / (kTimedFrames * kRepeats);
+  s.hand_pixels = pixels / kTimedFrames;
+  return s;
+}
+
+void print_evaluation(std::ostream& out, const PartForest& model, const EvalSummary& s) {
+  out << "model: " << model.trees().size() << " trees, " << model.node_count() << " nodes, depth " << model.max_depth()
+      << ", stride " << model.options().stride_px << "\n";
+  out << "held-out motions (" << s.motions.frames << " frames, " << s.motions.overall.total()
+      << " hand pixels): accuracy " << percent(s.motions.overall.accuracy()) << " (hand parts only "
+      << percent(s.motions.overall.part_accuracy()) << ")\n";
+  for (size_t m = 0; m < synth::kMotionNames.size(); ++m) {
+    out << "  " << synth::kMotionNames[m] << ": " << percent(s.motions.per_motion[m].accuracy()) << "\n";
+  }
+  out << "held-out random poses (" << s.scenes.total() << " hand pixels): accuracy " << percent(s.scenes.accuracy())
+      << " (hand parts only " << percent(s.scenes.part_accuracy()) << ")\n";
+  forest::Confusion all = s.motions.overall;
+  all.add(s.scenes);
+  out << "confusion, all held-out frames (% of each truth row):\n" << all.table();
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%.3f ms (thread CPU time) per 320x240 frame of %.0f hand pixels", s.ms_per_frame,
+                s.hand_pixels);
+  out << "label() time: " << buf << "\n";
+}
+
+int apply(const PartForest& model, const std::vector<std::string>& inputs, const fs::path& out_dir,
+          const CameraIntrinsics& camera_in, double far_mm) {
+  fs::create_directories(out_dir);
+  DepthInputConfig config;
+  config.far_mm = far_mm;
+  DepthInputBuilder builder(config);
+  std::vector<uint8_t> labels;
+  for (const auto& file : inputs) {
+    const Gray16Image raw = read_png_gray16(file);
+    if (raw.channels != 1) throw std::runtime_error(file + ": not a grayscale depth image");
+    CameraIntrinsics camera = camera_in;
+    camera.width = raw.width;
+    camera.height = raw.height;
+    const DepthImage depth = DepthImage::from_raw(camera, raw.pixels);
+    const DepthInput& in = builder.build(depth, std::nullopt);
+    const auto t0 = std::chrono::steady_clock::now();
+    model.label(in, labels);
+    const double ms = 1000.0 * seconds_since(t0);
+    // Left: depth (gray, hand mask tinted); right: part labels over a dim depth.
+    RgbImage img;
+    img.width = 2 * raw.width;
+    img.height = raw.height;
+    img.channels = 3;
+    img.pixels.assign(static_cast<size_t>(img.width) * static_cast<size_t>(img.height) * 3, 0);
+    std::array<int, kPartForestClasses> hist{};
+    for (int y = 0; y < raw.height; ++y) {
+      for (int x = 0; x < raw.width; ++x) {
+        const size_t i = static_cast<size_t>(y) * static_cast<size_t>(raw.width) + static_cast<size_t>(x);
+        const draw::Rgb g = draw::depth_gray(depth.depth_mm[i], 300.0, far_mm + 300.0);
+        const draw::Rgb left = in.hand_mask[i] ? draw::mix(g, draw::colours::kBlue, 0.3) : g;
+        const draw::Rgb right = in.hand_mask[i] ? draw::part_colour(labels[i]) : draw::shade(g, 0.35);
+        if (in.hand_mask[i]) ++hist[labels[i]];
+        const size_t l = (static_cast<size_t>(y) * static_cast<size_t>(img.width) + static_cast<size_t>(x)) * 3;
+        const size_t r = l + static_cast<size_t>(raw.width) * 3;
+        img.pixels[l] = left.r;
+        img.pixels[l + 1] = left.g;
+        img.pixels[l + 2] = left.b;
+        img.pixels[r] = right.r;
+        img.pixels[r + 1] = right.g;
+        img.pixels[r + 2] = right.b;
+      }
+    }
+    const fs::path p(file);
+    const fs::path out = out_dir / (p.parent_path().filename().string() + "_" + p.stem().string() + ".png");
+    write_png_rgb(out, img);
+    std::cout << out.string() << ": " << in.hand_pixels << " hand pixels, " << ms << " ms; classes";
+    for (int c = 0; c < kPartForestClasses; ++c) std::cout << " " << hist[static_cast<size_t>(c)];
+    std::cout << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Train the hand-part classification forest (Sec. 4.3 of Sridhar et al. 2015; Shotton et al. 2011 "
+               "depth features) on labelled synthetic renders, evaluate a model on held-out synthetic frames, or "
+               "label real depth frames.",
+               kProgram};
+  forest::TrainOptions train;
+  train.threads = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  forest::SceneOptions scene;
+  std::string out;
+  std::string evaluate_model;
+  std::string apply_model;
+  std::vector<std::string> inputs;
+  std::string output_dir = "forest_labels";
+  int images = 3000;
+  int eval_frames = 30;
+  int eval_scenes = 300;
+  int stride = PartForestOptions{}.stride_px;
+  double fx = 476.007, fy = 476.007, cx = 313.683, cy = 242.755, depth_scale = 0.125, far_mm = 900.0;
+  app.add_option("--out", out, "Model file to write (training)");
+  app.add_option("--trees", train.trees, "Number of trees (paper: 3)")->check(CLI::Range(1, 64));
+  app.add_option("--depth", train.max_depth, "Maximum tree depth (paper: 22)")->check(CLI::Range(1, 40));
+  app.add_option("--images", images, "Synthetic training images (paper: 50,000)")->check(CLI::Range(1, 10000000));
+  app.add_option("--pixels-per-image", train.pixels_per_image, "Hand pixels sampled per image and tree (paper: 2000)")
+      ->check(CLI::Range(1, 100000));
+  app.add_option("--candidates", train.candidates, "Feature/threshold pairs tried per node (paper: 4000)")
+      ->check(CLI::Range(1, 1000000));
+  app.add_option("--thresholds", train.thresholds_per_feature, "Thresholds tried per random feature")
+      ->check(CLI::Range(1, 1000));
+  app.add_option("--min-leaf", train.min_leaf_samples, "Fewest training pixels on each side of a split")
+      ->check(CLI::Range(1, 1000000));
+  app.add_option("--motion-fraction", scene.motion_fraction, "Share of images from the motion scripts")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--seed", train.seed, "Seed of the data set and of the training");
+  app.add_option("--threads", train.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 256));
+  app.add_option("--evaluate", evaluate_model, "Evaluate MODEL on held-out synthetic frames and print the "
+                                               "accuracy and the confusion matrix");
+  app.add_option("--eval-frames", eval_frames, "Held-out frames per motion script")->check(CLI::Range(1, 10000));
+  app.add_option("--eval-scenes", eval_scenes, "Held-out random-pose frames")->check(CLI::Range(0, 100000));
+  app.add_option("--stride", stride, "Classify one pixel per STRIDE x STRIDE block, per 320 px of width (--evaluate, --apply; default 2)")
+      ->check(CLI::Range(1, 16));
+  app.add_option("--apply", apply_model, "Label depth PNGs (--input) with MODEL into colour PNGs in --output-dir");
+  app.add_option("--input", inputs, "Depth PNGs for --apply (16-bit, raw units)");
+  app.add_option("--output-dir", output_dir, "Where --apply writes its PNGs");
+  app.add_option("--fx", fx, "--apply camera fx (default: the RealSense SR305 640x480)");
+  app.add_option("--fy", fy, "--apply camera fy");
+  app.add_option("--cx", cx, "--apply camera cx");
+  app.add_option("--cy", cy, "--apply camera cy");
+  app.add_option("--depth-scale", depth_scale, "--apply raw depth unit in mm")->check(CLI::PositiveNumber);
+  app.add_option("--far-mm", far_mm, "--apply far end of the working volume (mm)")->check(CLI::PositiveNumber);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::string what = e.what();
+    for (auto& c : what) {
+      if (c == '\n') c = ' ';
+    }
+    return fail(what + " (see --help)");
+  }
+
+  try {
+    if (!apply_model.empty()) {
+      if (inputs.empty()) return fail("--apply needs --input PNG...");
+      PartForest model = PartForest::load(apply_model, PartForestOptions{stride});
+      CameraIntrinsics camera;
+      camera.fx = fx;
+      camera.fy = fy;
+      camera.cx = cx;
+      camera.cy = cy;
+      camera.depth_scale_mm = depth_scale;
+      return apply(model, inputs, output_dir, camera, far_mm);
+    }
+    if (!evaluate_model.empty()) {
+      const PartForest model = PartForest::load(evaluate_model, PartForestOptions{stride});
+      print_evaluation(std::cout, model, evaluate(model, eval_frames, eval_scenes));
+      return 0;
+    }
+    if (out.empty()) return fail("--out is required to train (or use --evaluate / --apply; see --help)");
+    if (train.seed == kHeldOutSceneSeed) return fail("--seed collides with the held-out data set's seed");
+
+    Progress progress;
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto data = forest::make_dataset(train.seed, images, scene, train.threads, 150, [&](int done) {
+      progress.update("rendering", static_cast<double>(done) / images);
+    });
+    progress.done();
+    const double render_s = seconds_since(t0);
+    std::ostringstream command;
+    command << kProgram << " --out " << fs::path(out).filename().string() << " --trees " << train.trees << " --depth "
+            << train.max_depth << " --images " << images << " --pixels-per-image " << train.pixels_per_image
+            << " --candidates " << train.candidates << " --thresholds " << train.thresholds_per_feature
+            << " --min-leaf " << train.min_leaf_samples << " --motion-fraction " << scene.motion_fraction
+            << " --seed " << train.seed;
+    const auto t1 = std::chrono::steady_clock::now();
+    progress.restart();
+    PartForest model = forest::train_forest(data, scene.camera, train, command.str(), [&](const forest::TrainProgress& p) {
+      const double f = (p.tree + static_cast<double>(p.samples_done) / static_cast<double>(p.samples_total)) / train.trees;
+      progress.update("tree " + std::to_string(p.tree + 1) + "/" + std::to_string(train.trees), f);
+    });
+    progress.done();
+    const double train_s = seconds_since(t1);
+    const EvalSummary eval = evaluate(model, eval_frames, eval_scenes);
+    // The metadata holds only what the seed determines (no times, no thread count), so the same
+    // command writes the same file byte for byte.
+    std::ostringstream meta;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "\nheld-out accuracy: motions %.1f %%, random poses %.1f %%",
+                  100.0 * eval.motions.overall.accuracy(), 100.0 * eval.scenes.accuracy());
+    meta << command.str() << buf;
+    model = PartForest(model.trees(), PartForestInfo{model.info().reference_fx, model.info().reference_fy,
+                                                     model.info().background_mm, meta.str()});
+    model.save(out);
+    std::cout << meta.str() << "\n";
+    std::snprintf(buf, sizeof buf, "render %.0f s, train %.0f s on %d threads", render_s, train_s, train.threads);
+    std::cout << buf << "\n";
+    std::snprintf(buf, sizeof buf, "%.1f", static_cast<double>(fs::file_size(out)) / (1024.0 * 1024.0));
+    std::cout << "wrote " << out << " (" << buf << " MiB)\n";
+    print_evaluation(std::cout, model, eval);
+  } catch (const std::exception& e) {
+    return fail(e.what());
+  }
+  return 0;
+}
