@@ -68,6 +68,10 @@ int main(int argc, char** argv) {
   while (static_cast<int>(total.size()) < count) {
     st = client.wait_next(pose, std::chrono::nanoseconds(static_cast<int64_t>(timeout_s * 1e9)));
     const int64_t read_ns = now_ns();
+    if ((st == HANDTRACK_ERR_WRITER_STOPPED || st == HANDTRACK_ERR_WRITER_DEAD || st == HANDTRACK_TIMEOUT) &&
+        seen == 0 && read_ns < open_deadline + static_cast<int64_t>(timeout_s * 1e9)) {
+      continue;  // an earlier daemon's segment: the client reattaches to the new writer by itself
+    }
     if (st != HANDTRACK_OK) {
       std::fprintf(stderr, "handtrack-latency: after %zu records: %s\n", total.size(), handtrack_strerror(st));
       return 1;
