@@ -17,6 +17,9 @@ using Eigen::Vector3d;
 // fingertip is ~0.75 hand lengths from the palm centre; the margin allows for motion between frames
 // and a palm centre that is off.
 constexpr double kHandRadiusInLengths = 1.0;
+// Distance from the palm centre found by the distance transform down to the wrist cut, in hand
+// lengths (an open palm's centre is about a quarter hand length above the wrist).
+constexpr double kWristBelowPalmCentre = 0.25;
 // A hand is at most this many default hand lengths long (subjects vary by about 10 %).
 constexpr double kHandLengthMargin = 1.1;
 // The forearm is cut this far below the wrist joint (mm): the wrist's own surface stays in.
@@ -276,8 +279,8 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
     chamfer_distance(dist, w, h);
     const auto centre_px = static_cast<size_t>(std::max_element(dist.begin(), dist.end()) - dist.begin());
     centre = point(centre_px);
-    // The wrist sits about half a palm (a quarter of the hand length) below the palm centre.
-    wrist = centre - axis * (0.25 * length);
+    // The wrist sits about half a palm below the palm centre.
+    wrist = centre - axis * (kWristBelowPalmCentre * length);
     count = select();
     if (far_plane_cut_fraction(best) > kMaxFarPlaneCut) count = 0;
   }

@@ -53,6 +53,11 @@ void PoseTracker::reset() {
   low_confidence_run_ = 0;
 }
 
+void PoseTracker::override_pose(const PoseParams& pose) {
+  previous_ = pose;
+  before_previous_ = pose;
+}
+
 std::optional<HandHint> PoseTracker::hint() const {
   if (!previous_) return std::nullopt;
   const PosedHand hand(model_, *previous_);
@@ -210,17 +215,16 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   double conf = confidence(input, scratch_);
   low_confidence_run_ = conf < config_.lost_confidence ? low_confidence_run_ + 1 : 0;
   if (low_confidence_run_ >= config_.lost_frames && previous_) {
-    // The fit is clearly wrong: start again from the open hand on this very frame.
-    frame.previous = frame.before_previous = nullptr;
-    best = start();
-    started = true;
-    winner = -1;
-    guided_won = false;
-    scratch_.update(model_, best.params);
-    conf = confidence(input, scratch_);
+    // The fit is clearly wrong: forget the history, so the next frame is segmented without the
+    // wrong pose's hint and starts again from the open and closed hands. This frame reports
+    // "recovering" with the pose it has.
+    const PoseParams lost = best.params;
+    reset();
     recovering_ = true;
-    low_confidence_run_ = 0;
-    before_previous_.reset();
+    auto out = describe(lost, best.energy, input, TrackingState::kRecovering);
+    out.confidence = conf;
+    out.winning_particle = winner;
+    return out;
   } else if (conf >= config_.lost_confidence) {
     recovering_ = false;
   }

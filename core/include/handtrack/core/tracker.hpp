@@ -73,6 +73,9 @@ class PoseTracker {
   TrackerOutput optimise(const DepthInput& input);
   // Forget the history: the next frame starts from the open hand.
   void reset();
+  // Replaces the tracker's belief about the last pose (both previous poses) by `pose`: how tests
+  // knock the tracker off to check that it recovers.
+  void override_pose(const PoseParams& pose);
 
   [[nodiscard]] const HandModel& model() const { return model_; }
   [[nodiscard]] const TrackerConfig& config() const { return config_; }
