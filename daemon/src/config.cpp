@@ -108,6 +108,8 @@ const std::vector<Field>& fields() {
      "confidence below which a frame counts toward a restart", true},
     {"tracker.lost_frames", IntRef{[](DaemonConfig& c) -> int& { return c.tracker.lost_frames; }}, 1, 1000,
      "low-confidence frames in a row that trigger a restart", true},
+    {"tracker.min_start_confidence", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.min_start_confidence; }},
+     0, 1, "a (re)start that explains less of the segmented surface reports no hand", true},
     {"tracker.seed", Uint64Ref{[](DaemonConfig& c) -> uint64_t& { return c.tracker.seed; }}, 0, kMaxSeed,
      "random seed of the particle extrapolation", true},
     // [tracker.input] (Sec. 3.1, Sec. 4)
