@@ -1,0 +1,364 @@
+// The part forest (Sec. 4.3): the shipped model labels held-out synthetic hands correctly at least
+// 60 % of the time (the paper's figure on real data), the model file survives a round trip and
+// refuses corrupt files with one clear line and never a crash, the features follow Shotton et al.'s
+// definition (offsets scaled by 1 / depth and by the camera's focal length), and training is
+// deterministic whatever the thread count.
+
+#include "handtrack/core/part_forest.hpp"
+#include "handtrack/synth/synthetic_camera.hpp"
+#include "handtrack/train_forest/forest_data.hpp"
+#include "handtrack/train_forest/trainer.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace handtrack;
+namespace fs = std::filesystem;
+
+const fs::path kShippedModel = fs::path(HANDTRACK_SOURCE_DIR) / "data" / "part_forest.htf";
+
+// FNV-1a 64 as the file format defines it, to forge files whose checksum is right.
+uint64_t fnv1a64(const uint8_t* p, size_t n) {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  for (size_t i = 0; i < n; ++i) {
+    h ^= p[i];
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+void fix_checksum(std::vector<uint8_t>& bytes) {
+  if (bytes.size() < 8) return;
+  const uint64_t h = fnv1a64(bytes.data(), bytes.size() - 8);
+  std::memcpy(bytes.data() + bytes.size() - 8, &h, 8);
+}
+
+// A depth input of a flat square "hand" at `depth_mm` in the middle of the image.
+DepthInput square_input(int w, int h, float depth_mm, int half_side, double fx) {
+  DepthInput in;
+  in.camera.width = w;
+  in.camera.height = h;
+  in.camera.fx = in.camera.fy = fx;
+  in.camera.cx = w / 2.0;
+  in.camera.cy = h / 2.0;
+  in.filtered_mm.assign(static_cast<size_t>(w) * h, 0.0F);
+  in.hand_mask.assign(in.filtered_mm.size(), 0);
+  for (int y = h / 2 - half_side; y < h / 2 + half_side; ++y) {
+    for (int x = w / 2 - half_side; x < w / 2 + half_side; ++x) {
+      in.filtered_mm[static_cast<size_t>(y) * w + x] = depth_mm;
+      in.hand_mask[static_cast<size_t>(y) * w + x] = 1;
+    }
+  }
+  in.hand_pixels = 4 * half_side * half_side;
+  return in;
+}
+
+PartForestLeaf one_hot(int c) {
+  PartForestLeaf l{};
+  l[static_cast<size_t>(c)] = 65535;
+  return l;
+}
+
+// One stump: f = d(x + u / d(x)) - d(x) with u = (offset_pxmm, 0): a pixel whose probe to the right
+// leaves the hand reads the background (a large f) and goes right (class 2), others left (class 1).
+PartForest right_edge_stump(int16_t offset_pxmm, float reference_fx) {
+  PartForestTree t;
+  t.nodes.resize(3);
+  t.nodes[0].u = {offset_pxmm, 0};
+  t.nodes[0].v = {0, 0};
+  t.nodes[0].threshold = 100.0F;
+  t.nodes[0].child = 1;
+  t.nodes[1].child = PartForestNode::kLeafBit | 0U;
+  t.nodes[2].child = PartForestNode::kLeafBit | 1U;
+  t.leaves = {one_hot(1), one_hot(2)};
+  PartForestInfo info;
+  info.reference_fx = info.reference_fy = reference_fx;
+  info.metadata = "test stump";
+  return PartForest({t}, info, PartForestOptions{1});
+}
+
+// Pixels of row y labelled 2 (right edge zone) by the forest.
+int edge_width(const PartForest& f, const DepthInput& in) {
+  std::vector<uint8_t> labels;
+  f.label(in, labels);
+  const int y = in.camera.height / 2;
+  int count = 0;
+  for (int x = 0; x < in.camera.width; ++x) {
+    const uint8_t l = labels[static_cast<size_t>(y) * in.camera.width + x];
+    EXPECT_EQ(l == 0, in.hand_mask[static_cast<size_t>(y) * in.camera.width + x] == 0) << "x " << x;
+    count += l == 2 ? 1 : 0;
+  }
+  return count;
+}
+
+TEST(PartForestFeatures, OffsetsScaleWithOneOverDepthAndWithTheFocalLength) {
+  // u = 4000 px mm: 10 px at 400 mm, 5 px at 800 mm; the probe leaves the square for the last
+  // 10 (5) pixels of each row.
+  const PartForest f = right_edge_stump(4000, 200.0F);
+  EXPECT_EQ(edge_width(f, square_input(320, 240, 400.0F, 40, 200.0)), 10);
+  EXPECT_EQ(edge_width(f, square_input(320, 240, 800.0F, 40, 200.0)), 5);
+  // Twice the focal length (e.g. 640x480 instead of 320x240): twice the pixels.
+  EXPECT_EQ(edge_width(f, square_input(640, 480, 400.0F, 80, 400.0)), 20);
+}
+
+TEST(PartForestFeatures, ProbesOffTheHandMaskReadTheBackgroundNotTheDepth) {
+  const PartForest f = right_edge_stump(4000, 200.0F);
+  DepthInput in = square_input(320, 240, 400.0F, 40, 200.0);
+  // A surface just right of the hand at the same depth, but not on the mask: still background.
+  for (int y = 0; y < 240; ++y) {
+    for (int x = 200; x < 260; ++x) in.filtered_mm[static_cast<size_t>(y) * 320 + x] = 400.0F;
+  }
+  EXPECT_EQ(edge_width(f, in), 10);
+}
+
+TEST(PartForestFeatures, StrideLabelsEveryHandPixelAndNothingElse) {
+  PartForest f = right_edge_stump(4000, 200.0F);
+  const DepthInput in = square_input(320, 240, 400.0F, 41, 200.0);
+  for (int stride : {1, 2, 3}) {
+    f.set_options(PartForestOptions{stride});
+    std::vector<uint8_t> labels;
+    f.label(in, labels);
+    ASSERT_EQ(labels.size(), in.hand_mask.size());
+    for (size_t i = 0; i < labels.size(); ++i) ASSERT_EQ(labels[i] != 0, in.hand_mask[i] != 0) << "stride " << stride;
+  }
+  EXPECT_THROW(f.set_options(PartForestOptions{0}), std::invalid_argument);
+}
+
+TEST(PartForestFeatures, ProbeArithmeticRoundsHalvesUpAndClampsHugeScales) {
+  const int32_t k = probe_scale(1.0, 256.0F);  // 1/256 px per px mm, exact in 16.16
+  EXPECT_EQ(k, 256);
+  EXPECT_EQ(probe_coordinate(10, 2560, k), 20);
+  EXPECT_EQ(probe_coordinate(10, -2560, k), 0);
+  EXPECT_EQ(probe_coordinate(0, 128, k), 1);   // 0.5 -> 1
+  EXPECT_EQ(probe_coordinate(0, -128, k), 0);  // -0.5 -> 0
+  EXPECT_EQ(probe_coordinate(0, 4000, probe_scale(1.0, 400.0F)), 10);
+  EXPECT_GT(probe_coordinate(0, 32767, probe_scale(1.0, 0.0F)), 1000000);  // no overflow, far outside
+}
+
+// A small trained model for the file tests (trained once per process).
+const PartForest& small_model() {
+  static const PartForest model = [] {
+    const auto images = forest::make_dataset(11, 24, forest::SceneOptions{}, 2);
+    forest::TrainOptions o;
+    o.trees = 2;
+    o.max_depth = 8;
+    o.pixels_per_image = 100;
+    o.candidates = 200;
+    o.seed = 11;
+    return forest::train_forest(images, synth::default_camera(), o, "small test model");
+  }();
+  return model;
+}
+
+std::string load_error(const std::vector<uint8_t>& bytes) {
+  try {
+    (void)PartForest::from_bytes(bytes, "model.htf");
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+void expect_error(const std::vector<uint8_t>& bytes, const std::string& what) {
+  const std::string e = load_error(bytes);
+  ASSERT_FALSE(e.empty()) << "loaded, expected: " << what;
+  EXPECT_EQ(e.rfind("part forest model.htf: ", 0), 0U) << e;
+  EXPECT_NE(e.find(what), std::string::npos) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << "one line: " << e;
+}
+
+TEST(PartForestFile, RoundTripKeepsEveryByteAndEveryLabel) {
+  const PartForest& m = small_model();
+  const fs::path file = fs::path(HANDTRACK_BINARY_DIR) / "test_part_forest_roundtrip.htf";
+  m.save(file);
+  const PartForest back = PartForest::load(file);
+  EXPECT_EQ(back.to_bytes(), m.to_bytes());
+  EXPECT_EQ(back.info().metadata, "small test model");
+  EXPECT_EQ(back.node_count(), m.node_count());
+  synth::SynthOptions o;
+  o.motion = "fingercount";
+  synth::SyntheticCamera cam(o);
+  DepthInputBuilder builder;
+  const DepthInput& in = builder.build(cam.render(40).depth, std::nullopt);
+  std::vector<uint8_t> a;
+  std::vector<uint8_t> b;
+  m.label(in, a);
+  back.label(in, b);
+  EXPECT_EQ(a, b);
+  fs::remove(file);
+}
+
+TEST(PartForestFile, CorruptFilesGiveOneLineNamingTheProblem) {
+  const std::vector<uint8_t> good = small_model().to_bytes();
+  ASSERT_TRUE(load_error(good).empty());
+
+  auto bytes = good;
+  bytes[0] = 'X';
+  expect_error(bytes, "bad magic");
+  bytes = good;
+  bytes[8] = 2;  // version 2
+  expect_error(bytes, "unsupported format version 2");
+  for (size_t keep : {size_t{0}, size_t{5}, size_t{20}, size_t{40}, good.size() / 2, good.size() - 1}) {
+    expect_error(std::vector<uint8_t>(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(keep)), "truncated");
+  }
+  bytes = good;
+  bytes.push_back(0);
+  expect_error(bytes, "trailing garbage");
+  bytes = good;
+  bytes[good.size() / 2] ^= 0x10;  // one bit in the nodes
+  expect_error(bytes, "checksum mismatch");
+
+  // Forged files with a valid checksum: the structure is checked too.
+  const size_t metadata = std::string("small test model").size();
+  const size_t nodes_at = 36 + metadata + 8 * small_model().trees().size();
+  bytes = good;
+  const uint32_t far_child = 0x00FFFFFF;
+  std::memcpy(bytes.data() + nodes_at + 12, &far_child, 4);  // the root's child
+  fix_checksum(bytes);
+  expect_error(bytes, "out of range");
+  bytes = good;
+  const uint32_t self = 0;  // the root as its own child: a cycle
+  std::memcpy(bytes.data() + nodes_at + 12, &self, 4);
+  fix_checksum(bytes);
+  expect_error(bytes, "out of range");
+  bytes = good;
+  const auto& t0 = small_model().trees()[0];
+  const size_t leaves_at = nodes_at + 16 * t0.nodes.size();
+  std::memset(bytes.data() + leaves_at, 0, 2 * kPartForestClasses);
+  fix_checksum(bytes);
+  expect_error(bytes, "bad label");
+  bytes = good;
+  const uint32_t classes = 14;
+  std::memcpy(bytes.data() + 12, &classes, 4);
+  fix_checksum(bytes);
+  expect_error(bytes, "class count");
+
+  EXPECT_THROW((void)PartForest::load(fs::path(HANDTRACK_BINARY_DIR) / "no_such_model.htf"), std::runtime_error);
+}
+
+TEST(PartForestFile, ThousandsOfRandomMutationsNeverCrash) {
+  const std::vector<uint8_t> good = small_model().to_bytes();
+  synth::SynthOptions o;
+  o.motion = "pinch";
+  synth::SyntheticCamera cam(o);
+  DepthInputBuilder builder;
+  const DepthInput& in = builder.build(cam.render(10).depth, std::nullopt);
+  std::mt19937_64 rng(4);
+  std::vector<uint8_t> labels;
+  int loaded = 0;
+  int refused = 0;
+  for (int i = 0; i < 3000; ++i) {
+    std::vector<uint8_t> bytes = good;
+    const int edits = 1 + static_cast<int>(rng() % 4);
+    for (int e = 0; e < edits; ++e) {
+      const size_t at = rng() % bytes.size();
+      switch (rng() % 4) {
+        case 0:
+          bytes[at] ^= static_cast<uint8_t>(1U << (rng() % 8));
+          break;
+        case 1:
+          bytes[at] = static_cast<uint8_t>(rng());
+          break;
+        case 2:
+          bytes.resize(std::max<size_t>(1, at));
+          break;
+        default:  // a 32-bit field overwritten with an extreme value
+          for (size_t k = at; k < std::min(bytes.size(), at + 4); ++k) bytes[k] = (rng() % 2) ? 0xFF : 0x00;
+          break;
+      }
+    }
+    // Half the mutants get a valid checksum, so the structural checks are reached.
+    if (i % 2 == 1) fix_checksum(bytes);
+    try {
+      const PartForest f = PartForest::from_bytes(bytes, "mutant.htf");
+      f.label(in, labels);  // whatever loads must also run
+      ++loaded;
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+      ++refused;
+    }
+  }
+  EXPECT_GT(refused, 1500);
+  EXPECT_EQ(loaded + refused, 3000);
+}
+
+TEST(PartForestTraining, SameSeedSameModelForAnyThreadCount) {
+  const auto images = forest::make_dataset(5, 12, forest::SceneOptions{}, 2);
+  const auto images_one = forest::make_dataset(5, 12, forest::SceneOptions{}, 1);
+  ASSERT_EQ(images.size(), images_one.size());
+  for (size_t i = 0; i < images.size(); ++i) ASSERT_EQ(images[i].depth_mm, images_one[i].depth_mm);
+  forest::TrainOptions o;
+  o.trees = 2;
+  o.max_depth = 10;
+  o.pixels_per_image = 200;
+  o.candidates = 100;
+  o.seed = 3;
+  o.threads = 1;
+  const auto one = forest::train_forest(images, synth::default_camera(), o, "m").to_bytes();
+  o.threads = 2;
+  const auto two = forest::train_forest(images, synth::default_camera(), o, "m").to_bytes();
+  EXPECT_EQ(one, two);
+  o.seed = 4;
+  EXPECT_NE(forest::train_forest(images, synth::default_camera(), o, "m").to_bytes(), two);
+}
+
+TEST(SynthRenderPose, RenderingAMotionsPoseEqualsRenderingItsFrame) {
+  synth::SynthOptions o;
+  o.motion = "tigergrasp";
+  synth::SyntheticCamera cam(o);
+  synth::SynthFrame a;
+  synth::SynthFrame b;
+  cam.render(77, a);
+  cam.render_pose(cam.pose(77), 77, b);
+  EXPECT_EQ(a.depth.depth_mm, b.depth.depth_mm);
+  EXPECT_EQ(a.labels.pixels, b.labels.pixels);
+  // A different pose renders differently, and its joints follow it.
+  synth::HandPose p = cam.pose(77);
+  p.fingers[1][1] += 0.5;
+  cam.render_pose(p, 77, b);
+  EXPECT_NE(a.labels.pixels, b.labels.pixels);
+  EXPECT_GT((a.joints[static_cast<size_t>(fingertip_joint(1))] -
+             b.joints[static_cast<size_t>(fingertip_joint(1))]).norm(), 10.0);
+}
+
+TEST(ShippedPartForest, LoadsAndLabelsHeldOutSyntheticHandsAtLeast60PercentRight) {
+  ASSERT_TRUE(fs::exists(kShippedModel)) << kShippedModel;
+  const PartForest model = PartForest::load(kShippedModel);
+  EXPECT_EQ(model.trees().size(), 3U);
+  // Seven motion scripts, subjects and noise from seeds the training never used, 6 frames each.
+  const forest::HeldOutResult r = forest::evaluate_motions(model, 424242, 6);
+  EXPECT_EQ(r.frames, 42);
+  EXPECT_GE(r.overall.accuracy(), 0.60) << r.overall.table();
+  EXPECT_GE(r.overall.part_accuracy(), 0.60) << r.overall.table();
+  // Every part is found some of the time.
+  for (int c = 1; c < kPartForestClasses; ++c) EXPECT_GT(r.overall.class_recall(c), 0.25) << "class " << c;
+}
+
+TEST(ShippedPartForest, WorksAtOtherResolutions) {
+  const PartForest model = PartForest::load(kShippedModel);
+  synth::SynthOptions o;
+  o.motion = "fingerwave";
+  o.seed = 31337;
+  o.camera = synth::default_camera(640, 480);
+  synth::SyntheticCamera cam(o);
+  DepthInputBuilder builder;
+  synth::SynthFrame f;
+  forest::Confusion c;
+  std::vector<uint8_t> scratch;
+  for (int i = 0; i < 300; i += 50) {
+    cam.render(i, f);
+    const DepthInput& in = builder.build(f.depth, std::nullopt);
+    c.add(forest::score_frame(model, in, f.labels.pixels, scratch));
+  }
+  EXPECT_GE(c.accuracy(), 0.60) << c.table();
+}
+
+}  // namespace
