@@ -110,6 +110,9 @@ const std::vector<Field>& fields() {
      "low-confidence frames in a row that trigger a restart", true},
     {"tracker.min_start_confidence", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.min_start_confidence; }},
      0, 1, "a (re)start that explains less of the segmented surface reports no hand", true},
+    {"tracker.forest_model", StringRef{[](DaemonConfig& c) -> std::string& { return c.forest_model; }}, 0, 4096,
+     "part-classification forest file: late fusion with one detection-guided particle (Sec. 5); empty: depth-only",
+     false},
     {"tracker.seed", Uint64Ref{[](DaemonConfig& c) -> uint64_t& { return c.tracker.seed; }}, 0, kMaxSeed,
      "random seed of the particle extrapolation", true},
     // [tracker.input] (Sec. 3.1, Sec. 4)

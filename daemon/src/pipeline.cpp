@@ -3,6 +3,8 @@
 // and the step functions they share with the single-threaded loop (single_loop).
 #include "handtrack/daemon/pipeline.hpp"
 
+#include "handtrack/core/part_forest.hpp"
+
 #include "clock.hpp"
 #include "handtrack/core/kinematics.hpp"
 #include "logging.hpp"
@@ -158,6 +160,7 @@ struct Pipeline::Impl {
 
   // Optimize stage state.
   std::optional<PoseTracker> tracker;
+  std::optional<PartForest> forest;  // labels the hand's pixels for the detection-guided particle
   uint64_t tracker_generation = 0;
   uint64_t optimized = 0;
   uint64_t stall_after = 0;  // test hook: HANDTRACKD_TEST_STALL_OPTIMIZER_AFTER
@@ -422,7 +425,7 @@ struct Pipeline::Impl {
           std::lock_guard lock(hint_mutex);
           h = hint;
         }
-        f.input = &f.builder.build(f.depth, h, nullptr);
+        f.input = &f.builder.build(f.depth, h, forest ? &*forest : nullptr);
       }
     }
     f.preprocess_end_ns = monotonic_ns();
@@ -740,6 +743,16 @@ bool Pipeline::start(std::string* why) {
   } else {
     m.set_device_state(ipc::DeviceState::kWaitingForDevice);
   }
+  if (!m.config.forest_model.empty()) {
+    try {
+      m.forest.emplace(PartForest::load(m.config.forest_model));
+    } catch (const std::exception& e) {
+      *why = e.what();
+      return false;
+    }
+    m.config.tracker.mode = EnergyMode::kLateFusion;
+    log().info("part forest {}: late fusion", m.config.forest_model);
+  }
   m.input_config = m.config.tracker.input;
   m.reloaded = m.config.tracker;
   m.tracker.emplace(m.config.tracker);
@@ -871,6 +884,8 @@ void Pipeline::reload(const TrackerConfig& tracker) {
   {
     std::lock_guard lock(impl_->reload_mutex);
     impl_->reloaded = tracker;
+    // The forest is loaded once at start; a reload keeps the energy mode it chose.
+    impl_->reloaded.mode = impl_->config.tracker.mode;
   }
   impl_->generation.fetch_add(1, std::memory_order_acq_rel);
 }

@@ -62,6 +62,9 @@ struct DaemonConfig {
   PipelineConfig pipeline;
   // [tracker], [tracker.input], [tracker.energy], [tracker.optimizer], [tracker.scale]
   TrackerConfig tracker;
+  // Part-classification forest (handtrack-train-forest); set: late fusion (Sec. 5), empty:
+  // every particle optimises the depth-only energy.
+  std::string forest_model;
 
   // Which file the values came from (empty: built-in defaults only).
   std::filesystem::path file;
