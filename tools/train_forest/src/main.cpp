@@ -289,6 +289,9 @@ int main(int argc, char** argv) {
     });
     progress.done();
     const double train_s = seconds_since(t1);
+    // Scored at stride 1 (every pixel), whatever the default stride, so the metadata is fixed by
+    // the seed alone.
+    model.set_options(PartForestOptions{1});
     const EvalSummary eval = evaluate(model, eval_frames, eval_scenes);
     // The metadata holds only what the seed determines (no times, no thread count), so the same
     // command writes the same file byte for byte.
