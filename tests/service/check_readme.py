@@ -35,7 +35,8 @@ for field in fields:
     # A row of the table for `table`, naming the key in backquotes.
     if not re.search(rf"`{re.escape(field)}`|^\|\s*`\[{re.escape(table)}\]`.*`{re.escape(key)}`",
                      reference, re.M):
-        failures.append(f"configuration reference lacks {field}")
+        failures.append(f"configuration reference lacks {field} "
+                        "(regenerate the table with tests/service/config_reference.py)")
 for troubleshooting in ["no camera", "permission denied", "stale segment"]:
     if troubleshooting not in readme.lower():
         failures.append(f"Troubleshooting does not cover '{troubleshooting}'")

@@ -18,8 +18,9 @@ mount -t tmpfs tmpfs "$r/run"           # no systemd, no udev running in the chr
 mount -t tmpfs tmpfs "$r/tmp"
 in_root() { chroot "$r" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin "$@"; }
 
+cp "$deb" "$r/tmp/"                      # the chroot's /tmp is a fresh tmpfs
 in_root dpkg-query -W handtrack >/dev/null 2>&1 && fail "handtrack is already installed on this machine"
-in_root dpkg -i "$deb" > "$work/dpkg-install.log" 2>&1 || { cat "$work/dpkg-install.log"; fail "dpkg -i"; }
+in_root dpkg -i "/tmp/$(basename "$deb")" > "$work/dpkg-install.log" 2>&1 || { cat "$work/dpkg-install.log"; fail "dpkg -i"; }
 in_root dpkg -L handtrack | sort > "$work/dpkg-L.txt"
 echo "dpkg -i ok: $(wc -l < "$work/dpkg-L.txt") paths"
 
@@ -29,7 +30,8 @@ in_root getent group handtrack > /dev/null || fail "postinst did not create grou
 [ "$(in_root stat -c '%a %U %G' /var/lib/handtrack)" = "750 handtrack handtrack" ] \
   || fail "/var/lib/handtrack: $(in_root stat -c '%a %U %G' /var/lib/handtrack)"
 [ "$(in_root systemctl is-enabled handtrackd.service 2>/dev/null)" = enabled ] || fail "handtrackd.service not enabled"
-in_root ldconfig -p | grep -q 'libhandtrack_client.so.1 ' || fail "libhandtrack_client.so.1 not in the linker cache"
+cache="$(in_root ldconfig -p)"   # not piped into grep -q: with pipefail, SIGPIPE would fail it
+grep -q 'libhandtrack_client.so.1 ' <<< "$cache" || fail "libhandtrack_client.so.1 not in the linker cache"
 out="$(in_root systemd-analyze verify /usr/lib/systemd/system/handtrackd.service 2>&1)" \
   || { echo "$out"; fail "systemd-analyze verify of the installed unit"; }
 [ -z "$out" ] || { echo "$out"; fail "systemd-analyze verify warns about the installed unit"; }
