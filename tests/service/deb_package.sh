@@ -54,6 +54,9 @@ if [ "$(id -u)" != 0 ]; then echo "not root: dpkg -i / --purge skipped"; exit 77
 if ! grep -qw overlay /proc/filesystems || ! unshare -m true 2>/dev/null; then
   echo "no overlayfs or mount namespaces here: dpkg -i / --purge skipped"; exit 77
 fi
+if dpkg-query -W -f='${Status}' handtrack 2>/dev/null | grep -q 'ok installed'; then
+  echo "handtrack is installed on this machine: the scratch install would be an upgrade; skipped"; exit 77
+fi
 # The install/purge runs in a private mount namespace (the overlay vanishes with it); its
 # results come back through the files it writes to $work.
 unshare -m --propagation private "$here/deb_install_in_overlay.sh" "$deb" "$work" \
