@@ -1,9 +1,12 @@
 // handtrack-eval: track sequence directories and score them against their ground truth with the
 // paper's metrics (Sec. 7). SPEC.md "Evaluation output".
+#include "handtrack/core/part_forest.hpp"
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/core/tracker.hpp"
 #include "handtrack/draw/plot.hpp"
 #include "handtrack/eval/scoring.hpp"
+#include "handtrack/tools/cli.hpp"
+#include "handtrack/tools/progress.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -12,30 +15,15 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <unistd.h>
+#include <optional>
 
 namespace fs = std::filesystem;
 using namespace handtrack;
 
 namespace {
 
-// Progress with an estimate of the time left, only when stderr is a terminal (SPEC.md).
-class Progress {
- public:
-  explicit Progress(size_t total) : total_(total), tty_(::isatty(STDERR_FILENO) == 1) {}
-  void update(size_t done, const std::string& what) {
-    if (!tty_) return;
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    const double left = done > 0 ? elapsed * static_cast<double>(total_ - done) / static_cast<double>(done) : 0.0;
-    std::fprintf(stderr, "\r%s: %zu/%zu frames, %.0f s left   ", what.c_str(), done, total_, left);
-    if (done == total_) std::fprintf(stderr, "\n");
-  }
 
- private:
-  size_t total_;
-  bool tty_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-};
+constexpr const char* kProgram = "handtrack-eval";
 
 std::string sequence_name(const fs::path& dir) {
   const auto name = fs::path(dir).lexically_normal().filename().string();
@@ -60,6 +48,9 @@ int main(int argc, char** argv) {
   app.add_option("--plot", plot_file, "write a PNG plot of the per-frame error");
   app.add_option("--csv", csv_file, "write per-frame errors as CSV (sequence,frame,error_mm)");
   app.add_option("--energy", energy, "depth-only or late-fusion")->check(CLI::IsMember({"depth-only", "late-fusion"}));
+  std::string forest_file;
+  app.add_option("--forest", forest_file, "part-classification forest for late fusion (data/part_forest.htf)")
+      ->check(CLI::ExistingFile);
   app.add_option("--particles", config.particles, "pose particles per frame")->check(CLI::Range(1, 64));
   app.add_option("--iterations", config.optimizer.iterations, "optimizer iterations per particle")
       ->check(CLI::Range(1, 1000));
@@ -69,19 +60,17 @@ int main(int argc, char** argv) {
   app.add_option("--w-smo", config.weights.smoothness, "w_s, weight of E_smo (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
   bool sim_only = false;
   app.add_flag("--sim-only", sim_only, "E_sim only: drop E_col, E_lim and E_smo (ablation of Fig. 6)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+  if (const auto exit_code = tools::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
+  if (energy == "late-fusion" && forest_file.empty()) {
+    return tools::report_error(kProgram, "--energy late-fusion needs --forest MODEL (handtrack-train-forest)", 1);
   }
-  if (energy == "late-fusion") {
-    std::cerr << "handtrack-eval: --energy late-fusion needs the part-classification forest, which this build "
-                 "does not have yet; use --energy depth-only\n";
-    return 1;
-  }
+  if (energy == "late-fusion") config.mode = EnergyMode::kLateFusion;
   if (sim_only) config.weights.collision = config.weights.limits = config.weights.smoothness = 0.0;
 
   try {
+    std::optional<PartForest> forest;
+    if (config.mode == EnergyMode::kLateFusion) forest.emplace(PartForest::load(forest_file));
+    const PixelLabeller* labeller = forest ? &*forest : nullptr;
     std::vector<eval::SequenceScore> scores;
     std::vector<SequenceReader> readers;
     size_t total_frames = 0;
@@ -92,7 +81,7 @@ int main(int argc, char** argv) {
       }
       total_frames += readers.back().frame_count();
     }
-    Progress progress(total_frames);
+    tools::Progress progress(kProgram);
     size_t done = 0;
     for (const auto& reader : readers) {
       Tracker tracker(config);
@@ -101,10 +90,10 @@ int main(int argc, char** argv) {
       for (size_t i = 0; i < reader.frame_count(); ++i) {
         const DepthImage depth = reader.depth(i);
         const auto t0 = std::chrono::steady_clock::now();
-        const TrackerOutput out = tracker.track(depth);
+        const TrackerOutput out = tracker.track(depth, labeller);
         seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         scorer.add(out, reader.fingertips(i));
-        progress.update(++done, sequence_name(reader.dir()));
+        progress.update(sequence_name(reader.dir()), static_cast<double>(++done) / static_cast<double>(total_frames));
       }
       scores.push_back(scorer.finish(seconds));
     }
@@ -131,8 +120,7 @@ int main(int argc, char** argv) {
     // A human-readable table on stdout: the paper's Table 1 in our numbers.
     std::fputs(eval::format_table(scores, total).c_str(), stdout);
   } catch (const std::exception& e) {
-    std::cerr << "handtrack-eval: " << e.what() << "\n";
-    return 1;
+    return tools::report_error(kProgram, e.what(), 1);
   }
   return 0;
 }

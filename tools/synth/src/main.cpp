@@ -4,6 +4,8 @@
 
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
+#include "handtrack/tools/cli.hpp"
+#include "handtrack/tools/progress.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -26,10 +28,7 @@ namespace {
 
 constexpr const char* kProgram = "handtrack-synth";
 
-int fail(const std::string& message, int code = 1) {
-  std::cerr << kProgram << ": error: " << message << "\n";
-  return code;
-}
+int fail(const std::string& message) { return handtrack::tools::report_error(kProgram, message, 1); }
 
 // "L,W" -> SubjectScale; throws std::invalid_argument.
 handtrack::synth::SubjectScale parse_subject(const std::string& text) {
@@ -115,30 +114,6 @@ class PosesCsv {
   std::ofstream out_;
 };
 
-class Progress {
- public:
-  explicit Progress(int total) : total_(total), enabled_(isatty(STDERR_FILENO) != 0), start_(Clock::now()) {}
-  void update(int done) {
-    if (!enabled_) return;
-    const auto now = Clock::now();
-    if (done < total_ && now - last_ < std::chrono::milliseconds(200)) return;
-    last_ = now;
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
-    const double eta = done > 0 ? elapsed / done * (total_ - done) : 0.0;
-    std::fprintf(stderr, "\r%s: frame %d/%d (%3.0f%%), %.1f s left   ", kProgram, done, total_,
-                 100.0 * done / total_, eta);
-    if (done == total_) std::fprintf(stderr, "\n");
-    std::fflush(stderr);
-  }
-
- private:
-  using Clock = std::chrono::steady_clock;
-  int total_;
-  bool enabled_;
-  Clock::time_point start_;
-  Clock::time_point last_{};
-};
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -173,19 +148,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-labels", no_labels, "Do not write labels/");
   app.add_flag("--force", force, "Replace a sequence already in --out");
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::string what = e.what();
-    for (auto& c : what) {
-      if (c == '\n') c = ' ';
-    }
-    return fail(what + " (see --help)");
-  }
+  if (const auto exit_code = handtrack::tools::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
 
   if (list) {
     for (auto name : handtrack::synth::kMotionNames) {
@@ -216,7 +179,7 @@ int main(int argc, char** argv) {
     PosesCsv poses(dir / "poses.csv");
     if (preview) fs::create_directories(dir / "preview");
 
-    Progress progress(frames);
+    handtrack::tools::Progress progress(kProgram);
     handtrack::synth::SynthFrame frame;
     for (int i = 0; i < frames; ++i) {
       cam.render(i, frame);
@@ -226,7 +189,7 @@ int main(int argc, char** argv) {
       writer.write_joints(i, frame.joints);
       poses.write(i, frame.pose);
       if (preview) handtrack::write_png_rgb(handtrack::frame_file(dir / "preview", i), preview_image(frame));
-      progress.update(i + 1);
+      progress.update("frames", static_cast<double>(i + 1) / frames);
     }
     writer.flush();
   } catch (const std::invalid_argument& e) {

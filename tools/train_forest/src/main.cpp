@@ -7,6 +7,8 @@
 #include "handtrack/draw/colormap.hpp"
 #include "handtrack/train_forest/forest_data.hpp"
 #include "handtrack/train_forest/trainer.hpp"
+#include "handtrack/tools/cli.hpp"
+#include "handtrack/tools/progress.hpp"
 
 #include <CLI/CLI.hpp>
 #include <time.h>
@@ -31,32 +33,8 @@ constexpr const char* kProgram = "handtrack-train-forest";
 constexpr uint64_t kHeldOutMotionSeed = 900001;
 constexpr uint64_t kHeldOutSceneSeed = 0xE7A1'0000'0000ULL;
 
-int fail(const std::string& message, int code = 1) {
-  std::cerr << kProgram << ": error: " << message << "\n";
-  return code;
-}
+int fail(const std::string& message) { return handtrack::tools::report_error(kProgram, message, 1); }
 
-// Progress and time left on stderr, only when it is a terminal.
-class Progress {
- public:
-  Progress() : enabled_(isatty(STDERR_FILENO) != 0), start_(Clock::now()) {}
-  void restart() { start_ = Clock::now(); }
-  void update(const std::string& stage, double fraction) {
-    if (!enabled_) return;
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
-    const double eta = fraction > 0.0 ? elapsed / fraction * (1.0 - fraction) : 0.0;
-    std::fprintf(stderr, "\r%s: %s %3.0f%%, %.0f s left    ", kProgram, stage.c_str(), 100.0 * fraction, eta);
-    std::fflush(stderr);
-  }
-  void done() {
-    if (enabled_) std::fprintf(stderr, "\n");
-  }
-
- private:
-  using Clock = std::chrono::steady_clock;
-  bool enabled_;
-  Clock::time_point start_;
-};
 
 // CPU time of the calling thread: label() timings that other processes on the machine disturb less.
 double thread_cpu_seconds() {
@@ -234,19 +212,7 @@ int main(int argc, char** argv) {
   app.add_option("--depth-scale", depth_scale, "--apply raw depth unit in mm")->check(CLI::PositiveNumber);
   app.add_option("--far-mm", far_mm, "--apply far end of the working volume (mm)")->check(CLI::PositiveNumber);
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::string what = e.what();
-    for (auto& c : what) {
-      if (c == '\n') c = ' ';
-    }
-    return fail(what + " (see --help)");
-  }
+  if (const auto exit_code = handtrack::tools::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
 
   try {
     if (!apply_model.empty()) {
@@ -268,7 +234,7 @@ int main(int argc, char** argv) {
     if (out.empty()) return fail("--out is required to train (or use --evaluate / --apply; see --help)");
     if (train.seed == kHeldOutSceneSeed) return fail("--seed collides with the held-out data set's seed");
 
-    Progress progress;
+    handtrack::tools::Progress progress(kProgram);
     const auto t0 = std::chrono::steady_clock::now();
     const auto data = forest::make_dataset(train.seed, images, scene, train.threads, 150, [&](int done) {
       progress.update("rendering", static_cast<double>(done) / images);

@@ -5,6 +5,7 @@
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/core/tracker.hpp"
+#include "handtrack/tools/cli.hpp"
 
 #include <CLI/CLI.hpp>
 #include <unistd.h>
@@ -28,12 +29,7 @@ constexpr int kExitBadInput = 1;  // missing or corrupt files, frame out of rang
 constexpr int kExitUsage = 2;     // wrong command line
 
 int fail(const std::string& message, int code) {
-  std::string line = message;
-  for (auto& c : line) {
-    if (c == '\n') c = ' ';
-  }
-  std::cerr << kProgram << ": error: " << line << "\n";
-  return code;
+  return handtrack::tools::report_error(kProgram, message, code);
 }
 
 // A usage mistake found after parsing (exit 2), as opposed to bad input data (exit 1).
@@ -243,14 +239,8 @@ int main(int argc, char** argv) {
     app.get_option(name)->excludes(seq);
   }
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    return fail(std::string(e.what()) + " (see --help)", kExitUsage);
+  if (const auto exit_code = handtrack::tools::parse_command_line(app, argc, argv, kProgram, kExitUsage)) {
+    return *exit_code;
   }
   if (a.seq.empty() == a.depth.empty()) return fail("give either --seq DIR or --depth FILE.png (see --help)", kExitUsage);
 
