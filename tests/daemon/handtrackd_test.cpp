@@ -449,6 +449,25 @@ TEST_F(Handtrackd, AllZeroAndAllMaxRangeFramesAreNoHand) {
   for (const auto& p : parse_lines(cat.out())) EXPECT_EQ(p.at("state"), "no_hand");
 }
 
+// The real OpenNI2 recording (head and shoulders at ~1.5 m, a shoulder reaching to ~550 mm, no
+// hand in the working volume): every frame is read through OpenNI2 and published as "no hand".
+TEST_F(Handtrackd, RealOniRecordingWithoutAHandIsNoHand) {
+  const fs::path oni = fs::path(HANDTRACK_SHARED_DATA_DIR) / "oni" / "head-and-shoulders-640x480.oni";
+  if (!fs::exists(oni)) GTEST_SKIP() << "shared data absent: " << oni;
+  ShmName shm("oni");
+  Child cat({kCat, "--shm-name", shm.str(), "--count", "10", "--timeout", "20"}, dir_ / "cat.out", dir_ / "cat.err");
+  // At the recording's own 30 fps, so the cat has attached before most frames come.
+  const auto r = run(daemon_args({"--source", "oni:" + oni.string(), "--shm-name", shm.str()}), dir_, "d", 60s);
+  EXPECT_EQ(r.code, 0) << r.err;
+  const auto s = summary_of(r.err);
+  EXPECT_EQ(s.captured, 24) << r.err;
+  EXPECT_EQ(s.published + s.dropped, 24) << r.err;
+  ASSERT_EQ(cat.wait(20s), 0) << cat.err();
+  const auto poses = parse_lines(cat.out());
+  EXPECT_EQ(poses.size(), 10U);
+  for (const auto& p : poses) EXPECT_EQ(p.at("state"), "no_hand");
+}
+
 struct BadConfig {
   const char* toml;
   std::vector<std::string> names;  // besides the file name
