@@ -108,6 +108,17 @@ bool intrinsics_from_stream(openni::VideoStream& stream, CameraIntrinsics* camer
 // The parts every OpenNI2 source shares: one device, its depth stream, frame copying.
 class OpenNi2SourceBase : public DepthSource {
  public:
+  // Opens through the subclass's open_impl(); on failure closes what was opened and prefixes the
+  // reason with the source's name.
+  bool open(std::string* why) override {
+    std::string reason;
+    const bool ok = open_impl(&reason);
+    if (!ok) {
+      close();
+      if (why) *why = describe() + ": " + reason;
+    }
+    return ok;
+  }
   [[nodiscard]] CameraIntrinsics camera() const override { return camera_; }
   [[nodiscard]] std::string last_error() const override { return last_error_; }
 
@@ -148,6 +159,7 @@ class OpenNi2SourceBase : public DepthSource {
     return intrinsics_from_stream(*stream_, &camera_, why);
   }
 
+  virtual bool open_impl(std::string* why) = 0;
   virtual bool configure(std::string* why) = 0;
 
   enum class Wait { kReady, kTimeout, kLost, kError };
@@ -228,16 +240,6 @@ class OpenNi2Camera final : public OpenNi2SourceBase {
   [[nodiscard]] std::string describe() const override { return uri_.empty() ? "openni2" : "openni2:" + uri_; }
   [[nodiscard]] bool is_live() const override { return true; }
 
-  bool open(std::string* why) override {
-    std::string reason;
-    const bool ok = open_impl(&reason);
-    if (!ok) {
-      close();
-      if (why) *why = describe() + ": " + reason;
-    }
-    return ok;
-  }
-
   void close() override {
     OpenNi2SourceBase::close();
     std::lock_guard lock(watch_->uri_mutex);
@@ -281,7 +283,7 @@ class OpenNi2Camera final : public OpenNi2SourceBase {
     return true;
   }
 
-  bool open_impl(std::string* why) {
+  bool open_impl(std::string* why) override {
     close();
     if (!runtime_) {
       runtime_ = Runtime::acquire(why);
@@ -382,16 +384,6 @@ class OniRecording final : public OpenNi2SourceBase {
   [[nodiscard]] std::string describe() const override { return "oni:" + file_; }
   [[nodiscard]] bool is_live() const override { return false; }
 
-  bool open(std::string* why) override {
-    std::string reason;
-    const bool ok = open_impl(&reason);
-    if (!ok) {
-      close();
-      if (why) *why = describe() + ": " + reason;
-    }
-    return ok;
-  }
-
   GrabStatus grab(RawFrame& frame, std::chrono::milliseconds timeout) override {
     if (!stream_) return bad_frame("not open");
     if (ended_) return GrabStatus::kEndOfStream;
@@ -421,7 +413,7 @@ class OniRecording final : public OpenNi2SourceBase {
   }
 
  private:
-  bool open_impl(std::string* why) {
+  bool open_impl(std::string* why) override {
     close();
     ended_ = false;
     frames_read_ = 0;
