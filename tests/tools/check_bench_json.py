@@ -1,0 +1,31 @@
+#!/usr/bin/env python3
+"""Runs handtrack-bench briefly and checks its JSON against SPEC.md "Benchmark output"."""
+import json
+import math
+import subprocess
+import sys
+
+exe, out = sys.argv[1], sys.argv[2]
+subprocess.run([exe, "--frames", "20", "--json", out], check=True, stdout=subprocess.DEVNULL)
+with open(out) as f:
+    table = json.load(f)
+failures = []
+for name in ("depth_only_1p_10it", "depth_only_2p_10it", "late_fusion_2p_10it"):
+    entry = table.get(name)
+    if entry is None:
+        failures.append(f"{name}: missing")
+        continue
+    for key in ("fps", "preprocess_ms", "optimize_ms"):
+        value = entry.get(key)
+        if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+            failures.append(f"{name}.{key} = {value!r}")
+    latency = entry.get("latency_ms", {})
+    if not (0 < latency.get("p50", 0) <= latency.get("p99", 0)):
+        failures.append(f"{name}.latency_ms = {latency!r}")
+    if (entry.get("width"), entry.get("height")) != (320, 240):
+        failures.append(f"{name}: resolution {entry.get('width')}x{entry.get('height')}")
+if not failures and (table["depth_only_2p_10it"]["particles"], table["late_fusion_2p_10it"]["particles"]) != (2, 2):
+    failures.append("the 2-particle configurations do not run 2 particles")
+for f in failures:
+    print("FAIL:", f)
+sys.exit(1 if failures else 0)

@@ -1,0 +1,121 @@
+// handtrack-bench: the paper's speed table (Sec. 7, "Tracking Speed") in one process, on one
+// synthetic 320x240 input: each configuration tracks the same pre-rendered frames on one thread;
+// preprocessing (median, segmentation, forest labels, quadtree) and optimisation are timed apart.
+// SPEC.md "Benchmark output".
+#include "handtrack/core/part_forest.hpp"
+#include "handtrack/core/tracker.hpp"
+#include "handtrack/synth/synthetic_camera.hpp"
+#include "handtrack/tools/cli.hpp"
+#include "handtrack/tools/progress.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <vector>
+
+using namespace handtrack;
+
+namespace {
+
+constexpr const char* kProgram = "handtrack-bench";
+
+struct BenchConfig {
+  std::string name;
+  EnergyMode mode;
+  int particles;
+  int iterations;
+};
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
+}
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"The paper's speed table: every configuration on the same synthetic 320x240 frames, one thread."};
+  std::string json_file;
+  std::string forest_file = HANDTRACK_DEFAULT_FOREST;
+  std::string motion = "random";
+  int frames = 300;
+  app.add_option("--json", json_file, "write the table as JSON (SPEC.md)");
+  app.add_option("--forest", forest_file, "part forest for the late-fusion configuration")->check(CLI::ExistingFile);
+  app.add_option("--motion", motion, "synthetic motion to track");
+  app.add_option("--frames", frames, "frames per configuration")->check(CLI::Range(10, 100000));
+  if (const auto exit_code = tools::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
+
+  try {
+    const PartForest forest = PartForest::load(forest_file);
+    synth::SynthOptions options;
+    options.motion = motion;
+    options.frames = frames;
+    options.seed = 7;
+    synth::SyntheticCamera camera(options);
+    std::vector<DepthImage> input;
+    for (int i = 0; i < frames; ++i) input.push_back(camera.render(i).depth);
+
+    const std::vector<BenchConfig> configs = {{"depth_only_1p_10it", EnergyMode::kDepthOnly, 1, 10},
+                                              {"depth_only_2p_10it", EnergyMode::kDepthOnly, 2, 10},
+                                              {"late_fusion_2p_10it", EnergyMode::kLateFusion, 2, 10}};
+    nlohmann::json out = nlohmann::json::object();
+    tools::Progress progress(kProgram);
+    std::printf("%-22s %8s %14s %12s %16s\n", "configuration", "fps", "preprocess_ms", "optimize_ms", "latency p50/p99");
+    for (size_t c = 0; c < configs.size(); ++c) {
+      const auto& bc = configs[c];
+      TrackerConfig tc;
+      tc.mode = bc.mode;
+      tc.particles = bc.particles;
+      tc.optimizer.iterations = bc.iterations;
+      DepthInputBuilder builder(tc.input);
+      PoseTracker tracker(tc);
+      const PixelLabeller* labeller = bc.mode == EnergyMode::kLateFusion ? &forest : nullptr;
+      std::vector<double> pre_ms, opt_ms, latency_ms;
+      const auto start = std::chrono::steady_clock::now();
+      for (int i = 0; i < frames; ++i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const DepthInput& in = builder.build(input[static_cast<size_t>(i)], tracker.hint(), labeller);
+        const auto t1 = std::chrono::steady_clock::now();
+        (void)tracker.optimise(in);
+        pre_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+        opt_ms.push_back(ms_since(t1));
+        latency_ms.push_back(pre_ms.back() + opt_ms.back());
+        progress.update(bc.name, (static_cast<double>(c) + static_cast<double>(i + 1) / frames) / configs.size());
+      }
+      const double fps = frames / (ms_since(start) / 1000.0);
+      const double pre = percentile(pre_ms, 0.5);
+      const double opt = percentile(opt_ms, 0.5);
+      const double p50 = percentile(latency_ms, 0.5);
+      const double p99 = percentile(latency_ms, 0.99);
+      out[bc.name] = {{"fps", fps},
+                      {"preprocess_ms", pre},
+                      {"optimize_ms", opt},
+                      {"latency_ms", {{"p50", p50}, {"p99", p99}}},
+                      {"particles", bc.particles},
+                      {"iterations", bc.iterations},
+                      {"width", camera.camera().width},
+                      {"height", camera.camera().height},
+                      {"frames", frames}};
+      std::printf("%-22s %8.1f %14.2f %12.2f %9.2f/%.2f\n", bc.name.c_str(), fps, pre, opt, p50, p99);
+    }
+    progress.done();
+    if (!json_file.empty()) {
+      std::ofstream f(json_file);
+      if (!f) throw std::runtime_error(json_file + ": cannot write");
+      f << out.dump(2) << "\n";
+    }
+  } catch (const std::exception& e) {
+    return tools::report_error(kProgram, e.what(), 1);
+  }
+  return 0;
+}
