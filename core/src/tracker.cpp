@@ -60,9 +60,10 @@ void PoseTracker::override_pose(const PoseParams& pose) {
 
 std::optional<HandHint> PoseTracker::hint() const {
   if (!previous_) return std::nullopt;
-  const PosedHand hand(model_, *previous_);
-  return HandHint{hand.to_camera(model_.palm_centre()), hand.camera_t_hand(),
-                  hand.camera_R_hand() * Vector3d::UnitY()};
+  // Only the global transform matters (no PosedHand: nothing is allocated on the hot path).
+  const Vector3d t = previous_->segment<3>(kTranslationParam);
+  const Eigen::Matrix3d camera_R_hand = rotation_exp(previous_->segment<3>(kRotationParam)) * frontal_rotation();
+  return HandHint{t + camera_R_hand * model_.palm_centre(), t, camera_R_hand * Vector3d::UnitY()};
 }
 
 PoseParams PoseTracker::initial_pose(const DepthInput& input, double in_plane_offset_rad, bool closed) const {

@@ -6,7 +6,6 @@
 #include "handtrack/core/part_forest.hpp"
 
 #include "clock.hpp"
-#include "handtrack/core/kinematics.hpp"
 #include "logging.hpp"
 
 #include <boost/lockfree/spsc_queue.hpp>
@@ -492,15 +491,8 @@ struct Pipeline::Impl {
       f.output = TrackerOutput{};
     }
     f.scale = tracker->config().scale;
-    // Hint for the next frames' segmentation: what PoseTracker::hint() computes, from the output
-    // (palm centre, wrist = the translation, fingers along camera_R_hand * y), without allocating.
-    std::optional<HandHint> h;
-    if (f.output.state != TrackingState::kNoHand) {
-      const Eigen::Vector3d r = f.output.params.segment<3>(kRotationParam);
-      const Eigen::Matrix3d camera_R_hand = rotation_exp(r) * frontal_rotation();
-      h = HandHint{f.output.palm_centre, f.output.params.segment<3>(kTranslationParam),
-                   camera_R_hand * Eigen::Vector3d::UnitY()};
-    }
+    // Hint for the next frames' segmentation (none after a loss: the next frame starts afresh).
+    const std::optional<HandHint> h = tracker->hint();
     {
       std::lock_guard lock(hint_mutex);
       hint = h;

@@ -67,7 +67,8 @@ class PoseTracker {
  public:
   explicit PoseTracker(TrackerConfig config = {});
 
-  // Where segmentation should look for the hand in the next frame (none before the first pose).
+  // Where segmentation should look for the hand in the next frame: none before the first pose and
+  // after the fit was lost (the next frame is segmented afresh). Allocates nothing.
   [[nodiscard]] std::optional<HandHint> hint() const;
   // Optimises the pose for one frame's C_I and updates the history.
   TrackerOutput optimise(const DepthInput& input);
