@@ -222,7 +222,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     const PoseParams lost = best.params;
     reset();
     recovering_ = true;
-    auto out = describe(lost, best.energy, input, TrackingState::kRecovering);
+    auto out = describe(lost, best.energy, TrackingState::kRecovering);
     out.confidence = conf;
     out.winning_particle = winner;
     return out;
@@ -234,14 +234,14 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   if (started && conf < config_.min_start_confidence) return no_hand();
   before_previous_ = previous_;
   previous_ = best.params;
-  auto out = describe(best.params, best.energy, input, recovering_ ? TrackingState::kRecovering : TrackingState::kTracking);
+  auto out = describe(best.params, best.energy, recovering_ ? TrackingState::kRecovering : TrackingState::kTracking);
   out.confidence = conf;
   out.winning_particle = winner;
   out.detection_guided_won = guided_won;
   return out;
 }
 
-TrackerOutput PoseTracker::describe(const PoseParams& params, double energy, const DepthInput& /*input*/,
+TrackerOutput PoseTracker::describe(const PoseParams& params, double energy,
                                     TrackingState state) {
   TrackerOutput out;
   out.state = state;

@@ -89,7 +89,7 @@ class PoseTracker {
   [[nodiscard]] double confidence(const DepthInput& input, const PosedHand& hand) const;
 
  private:
-  TrackerOutput describe(const PoseParams& params, double energy, const DepthInput& input, TrackingState state);
+  TrackerOutput describe(const PoseParams& params, double energy, TrackingState state);
 
   TrackerConfig config_;
   HandModel model_;
