@@ -2,6 +2,8 @@
 // validation, --print-config and the docs, so a field cannot be parsed without being checked.
 #include "handtrack/daemon/config.hpp"
 
+#include "handtrack/core/hand_calibration.hpp"
+
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
@@ -112,6 +114,9 @@ const std::vector<Field>& fields() {
      0, 1, "a (re)start that explains less of the segmented surface reports no hand", true},
     {"tracker.forest_model", StringRef{[](DaemonConfig& c) -> std::string& { return c.forest_model; }}, 0, 4096,
      "part-classification forest file: late fusion with one detection-guided particle (Sec. 5); empty: depth-only",
+     false},
+    {"tracker.hand_profile", StringRef{[](DaemonConfig& c) -> std::string& { return c.hand_profile; }}, 0, 4096,
+     "hand profile file (handtrack-calibrate, Sec. 6): its scales replace tracker.scale; empty: tracker.scale",
      false},
     {"tracker.seed", Uint64Ref{[](DaemonConfig& c) -> uint64_t& { return c.tracker.seed; }}, 0, kMaxSeed,
      "random seed of the particle extrapolation", true},
@@ -328,6 +333,13 @@ DaemonConfig from_table(const toml::table& table, const std::string& origin) {
   DaemonConfig c;
   walk(c, table, "", origin);
   validate(c, origin);
+  if (!c.hand_profile.empty()) {
+    try {
+      c.tracker.scale = load_hand_profile(c.hand_profile);
+    } catch (const std::exception& e) {
+      fail(origin, std::string("tracker.hand_profile: ") + e.what());
+    }
+  }
   return c;
 }
 

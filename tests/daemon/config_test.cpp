@@ -84,6 +84,21 @@ TEST(DaemonConfig, MissingDefaultFileIsFineMissingExplicitFileIsNot) {
   EXPECT_THROW((void)load_config("/nonexistent/handtrackd.toml", true), ConfigError);
 }
 
+TEST(DaemonConfig, HandProfileReplacesTheScaleAndABadOneIsRefusedNamingIt) {
+  const std::string file = ::testing::TempDir() + "/config_test_profile.json";
+  std::ofstream(file) << R"({"hand_length": 1.1, "hand_width": 0.95, "gaussian_sigma": 1.05})";
+  const auto c = parse_config("[tracker]\nhand_profile = '" + file + "'\n", "test.toml");
+  EXPECT_DOUBLE_EQ(c.tracker.scale.length, 1.1);
+  EXPECT_DOUBLE_EQ(c.tracker.scale.width, 0.95);
+  EXPECT_DOUBLE_EQ(c.tracker.scale.sigma, 1.05);
+  std::ofstream(file) << R"({"hand_length": 1.1, "hand_width": 3, "gaussian_sigma": 1.05})";
+  const auto e = error_of("[tracker]\nhand_profile = '" + file + "'\n");
+  EXPECT_NE(e.find("test.toml"), std::string::npos) << e;
+  EXPECT_NE(e.find("tracker.hand_profile"), std::string::npos) << e;
+  EXPECT_NE(e.find("hand_width"), std::string::npos) << e;
+  EXPECT_NE(error_of("[tracker]\nhand_profile = '/nonexistent/profile.json'\n").find("cannot open"), std::string::npos);
+}
+
 TEST(DaemonConfig, ReloadTellsWhichFieldsNeedARestart) {
   DaemonConfig a;
   DaemonConfig b;

@@ -1,5 +1,6 @@
 // handtrack-eval: track sequence directories and score them against their ground truth with the
 // paper's metrics (Sec. 7). SPEC.md "Evaluation output".
+#include "handtrack/core/hand_calibration.hpp"
 #include "handtrack/core/part_forest.hpp"
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/core/tracker.hpp"
@@ -58,6 +59,8 @@ int main(int argc, char** argv) {
   app.add_option("--w-col", config.weights.collision, "w_c, weight of E_col (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
   app.add_option("--w-lim", config.weights.limits, "w_l, weight of E_lim (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
   app.add_option("--w-smo", config.weights.smoothness, "w_s, weight of E_smo (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
+  std::string hand_profile;
+  app.add_option("--hand-profile", hand_profile, "hand profile (handtrack-calibrate): the user's hand scale (Sec. 6)");
   bool sim_only = false;
   app.add_flag("--sim-only", sim_only, "E_sim only: drop E_col, E_lim and E_smo (ablation of Fig. 6)");
   if (const auto exit_code = tools::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
@@ -69,6 +72,7 @@ int main(int argc, char** argv) {
 
   try {
     std::optional<PartForest> forest;
+    if (!hand_profile.empty()) config.scale = load_hand_profile(hand_profile);
     if (config.mode == EnergyMode::kLateFusion) forest.emplace(PartForest::load(forest_file));
     const PixelLabeller* labeller = forest ? &*forest : nullptr;
     std::vector<eval::SequenceScore> scores;

@@ -65,6 +65,9 @@ struct DaemonConfig {
   // Part-classification forest (handtrack-train-forest); set: late fusion (Sec. 5), empty:
   // every particle optimises the depth-only energy.
   std::string forest_model;
+  // Hand profile (handtrack-calibrate, Sec. 6): loaded with the configuration, its scales replace
+  // tracker.scale; empty: tracker.scale as configured.
+  std::string hand_profile;
 
   // Which file the values came from (empty: built-in defaults only).
   std::filesystem::path file;
