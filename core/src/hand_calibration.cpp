@@ -135,7 +135,7 @@ CalibrationResult calibrate_hand_scale(const std::vector<CalibrationFrame>& fram
   PosedHand scratch;
   std::vector<float> rendered;
 
-  // Re-fits every frame's pose for `scale` from `poses` (updated in place) and returns mean S.
+  // Re-fits every frame's pose for `scale` from `poses` (updated in place) and returns the mean score.
   const auto fit_and_score = [&](const HandScale& scale, std::vector<PoseParams>& poses) {
     const HandModel model = HandModel::default_adult(scale);
     double total = 0.0;
