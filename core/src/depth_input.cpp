@@ -78,6 +78,7 @@ const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::o
   if (labeller != nullptr && out_.hand_pixels > 0) labeller->label(out_, out_.pixel_labels);
   build_quadtree();
   out_.self_similarity = image_self_similarity(out_.gaussians);
+  out_.mixture.assign(out_.gaussians);
   return out_;
 }
 

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <stdexcept>
 
 namespace handtrack {
 namespace {
@@ -81,6 +82,9 @@ void PosedHand::update(const HandModel& model, const PoseParams& params) {
   }
 
   const auto& gaussians = model.gaussians();
+  if (gaussians.size() > static_cast<size_t>(kMaxModelGaussians)) {
+    throw std::invalid_argument("hand model: more Gaussians than kMaxModelGaussians");
+  }
   centres_.resize(gaussians.size());
   frontal_points_.resize(gaussians.size());
   bones_.resize(gaussians.size());
@@ -113,6 +117,43 @@ void PosedHand::add_point_gradient(int gaussian, const Vector3d& dE_dp, PoseGrad
   for (int d = 0; d < dofs; ++d) {
     const auto& t = tw[static_cast<size_t>(d)];
     gradient[angle_param(f, d)] += t.axis.cross(p - t.pivot).dot(dE_dp);
+  }
+}
+
+void PosedHand::add_centre_gradients(const CentreGradients& dE_dcentres, PoseGradient& gradient) const {
+  // Force and torque about the wrist t per bone (the palm is bone kPalmBone), see the header.
+  std::array<Vector3d, kPalmBone + 1> force;
+  std::array<Vector3d, kPalmBone + 1> torque;
+  force.fill(Vector3d::Zero());
+  torque.fill(Vector3d::Zero());
+  for (size_t i = 0; i < centres_.size(); ++i) {
+    const Vector3d g = dE_dcentres.col(static_cast<Eigen::Index>(i));
+    const auto b = static_cast<size_t>(bones_[i]);
+    force[b] += g;
+    torque[b] += (centres_[i] - camera_t_hand_).cross(g);
+  }
+  Vector3d total_force = Vector3d::Zero();
+  Vector3d total_torque = Vector3d::Zero();
+  for (size_t b = 0; b <= kPalmBone; ++b) {
+    total_force += force[b];
+    total_torque += torque[b];
+  }
+  gradient.segment<3>(kTranslationParam) += total_force;
+  gradient.segment<3>(kRotationParam) += right_jacobian_.transpose() * (exp_r_.transpose() * total_torque);
+  for (int f = 0; f < kNumFingers; ++f) {
+    // Joint d moves bones >= max(0, d - 1) of its finger: sum the bones from the tip down.
+    Vector3d moved_force = Vector3d::Zero();
+    Vector3d moved_torque = Vector3d::Zero();
+    const auto& tw = twists_[static_cast<size_t>(f)];
+    for (int b = kBonesPerFinger - 1; b >= 0; --b) {
+      const auto bone = static_cast<size_t>(f * kBonesPerFinger + b);
+      moved_force += force[bone];
+      moved_torque += torque[bone];
+      for (int d = b == 0 ? 0 : b + 1; d <= b + 1; ++d) {
+        const auto& t = tw[static_cast<size_t>(d)];
+        gradient[angle_param(f, d)] += t.axis.dot(moved_torque - (t.pivot - camera_t_hand_).cross(moved_force));
+      }
+    }
   }
 }
 

@@ -42,6 +42,7 @@ DepthInput synthetic_input(const HandModel& model, const PoseParams& pose, std::
     }
   }
   in.self_similarity = image_self_similarity(in.gaussians);
+  in.mixture.assign(in.gaussians);
   return in;
 }
 

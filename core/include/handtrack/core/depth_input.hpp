@@ -4,6 +4,7 @@
 // leaves become unit-weight 2D Gaussians.
 
 #include "handtrack/core/camera.hpp"
+#include "handtrack/core/image_mixture.hpp"
 
 #include <Eigen/Core>
 
@@ -51,6 +52,7 @@ struct DepthInput {
   std::vector<uint8_t> hand_mask;     // 1 = pixel belongs to the segmented hand
   std::vector<uint8_t> pixel_labels;  // part label per pixel (0 = none); empty without a labeller
   std::vector<ImageGaussian> gaussians;
+  ImageMixture mixture;               // `gaussians` laid out for E_sim; assign(gaussians) after changing them
   double self_similarity = 0.0;       // E(C_I, C_I), normalises E_sim (Sec. 4.1)
   int hand_pixels = 0;
   Eigen::Vector3d hand_centroid_mm = Eigen::Vector3d::Zero();  // mean 3D point of the hand pixels

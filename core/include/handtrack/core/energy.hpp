@@ -42,10 +42,17 @@ enum class SimilarityFactor {
 //   dD/dsigma_p = D (2/sigma_p - 2 sigma_p / S + |mu_p - mu_q|^2 sigma_p / S^2)
 //   dDelta/dd_p = -sign(d_p - d_q) / (2 sigma_h)    (resp. / (2 R_i))
 // chained through the projection to the 3D mean and then to Theta (PosedHand).
+//
+// The pair sums read DepthInput::mixture (C_I as structure-of-arrays, built once per frame): per
+// model Gaussian only the slice of image Gaussians within the depth factor's reach (and, for the
+// label factor, of its label), summed branch-free in SIMD with an exp that needs no libm call.
 class SimilarityTerm {
  public:
   SimilarityTerm(SimilarityFactor factor, double label_radius_mm) : factor_(factor), label_radius_mm_(label_radius_mm) {}
   double evaluate(const HandModel& model, const PosedHand& hand, const DepthInput& input, PoseGradient* gradient) const;
+  // E_sim, adding dE_sim/d centre of each model Gaussian into *dE_dcentres when not null.
+  double evaluate_centres(const HandModel& model, const PosedHand& hand, const DepthInput& input,
+                          CentreGradients* dE_dcentres) const;
 
  private:
   SimilarityFactor factor_;
@@ -58,6 +65,8 @@ class SimilarityTerm {
 class CollisionTerm {
  public:
   double evaluate(const HandModel& model, const PosedHand& hand, PoseGradient* gradient) const;
+  // E_col, adding dE_col/d centre of each model Gaussian into *dE_dcentres when not null.
+  double evaluate_centres(const HandModel& model, const PosedHand& hand, CentreGradients* dE_dcentres) const;
 };
 
 // E_lim = sum_j (theta_j^l - theta_j)^2 below the limit, (theta_j - theta_j^h)^2 above   (eq. 9)

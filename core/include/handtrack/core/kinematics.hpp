@@ -7,6 +7,10 @@
 //   dp/dt      = I
 //   dp/dr      = -exp([r]x) [R0 q]x J_r(r)   (J_r: right Jacobian of SO(3))
 //   dp/dtheta_j = w_j x (p - c_j)            (twist of revolute joint j: world axis w_j through c_j)
+// Summed over many points (PosedHand::add_centre_gradients) the chain needs only each bone's total
+// force F = sum_i g_i and torque tau = sum_i (p_i - t) x g_i, with g_i = dE/dp_i:
+//   dE/dt = F,  dE/dr = J_r(r)^T exp([r]x)^T tau,  dE/dtheta_j = w_j . (tau_j - (c_j - t) x F_j)
+// where F_j, tau_j sum over the points that joint j moves (a x R^T b = R^T (R a x b), R R0 q = p - t).
 
 #include "handtrack/core/hand_model.hpp"
 #include "handtrack/core/pose.hpp"
@@ -25,6 +29,11 @@ Eigen::Matrix3d rotation_exp(const Eigen::Vector3d& r);
 Eigen::Matrix3d right_jacobian(const Eigen::Vector3d& r);
 // log of a rotation matrix: the r with exp([r]x) = R, |r| <= pi.
 Eigen::Vector3d rotation_log(const Eigen::Matrix3d& rotation);
+
+// dE/d centre (camera frame) of every model Gaussian, one column each. A fixed capacity keeps it
+// on the stack: no allocation per energy evaluation.
+inline constexpr int kMaxModelGaussians = 64;
+using CentreGradients = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, kMaxModelGaussians>;
 
 class PosedHand {
  public:
@@ -48,6 +57,9 @@ class PosedHand {
 
   // gradient += (d centre(gaussian) / d params)^T * dE_dp: the chain rule for one model point.
   void add_point_gradient(int gaussian, const Eigen::Vector3d& dE_dp, PoseGradient& gradient) const;
+  // The same for all model Gaussians at once (column i = dE/d centre(i), gaussian_count() columns),
+  // in one pass through the kinematic chain: what the energy terms use.
+  void add_centre_gradients(const CentreGradients& dE_dcentres, PoseGradient& gradient) const;
 
  private:
   struct Twist {

@@ -1,0 +1,53 @@
+#pragma once
+// The image mixture C_I laid out for E_sim's pair sums (paper eq. 6): structure-of-arrays columns,
+// built once per frame (DepthInputBuilder::build) and read by every energy evaluation.
+//
+// A model Gaussian p only interacts with the image Gaussians q inside its depth factor's reach:
+// Delta(p,q) = 0 for |d_p - d_q| >= reach (eq. 7; Sec. 4.3 for the label factor, which also needs
+// l_p = l_q). So the mixture is kept twice: ordered by depth, and grouped by part label with each
+// group ordered by depth. The Gaussians a model Gaussian can reach are then one contiguous slice of
+// the columns, found by binary search.
+
+#include <cstddef>
+#include <vector>
+
+namespace handtrack {
+
+struct ImageGaussian;
+
+// A contiguous run of image Gaussians: means (px), sigma_q^2 (px^2) and depths d_q (mm).
+struct ImageMixtureSlice {
+  const double* u = nullptr;
+  const double* v = nullptr;
+  const double* sigma2 = nullptr;
+  const double* depth_mm = nullptr;
+  std::size_t size = 0;
+};
+
+class ImageMixture {
+ public:
+  // Rebuilds the columns from the quadtree's Gaussians (labels >= 0). Storage is reused: no
+  // allocation once a frame of this size has been seen.
+  void assign(const std::vector<ImageGaussian>& gaussians);
+
+  [[nodiscard]] std::size_t size() const { return by_depth_.depth_mm.size(); }
+  // The image Gaussians with lo_mm <= d_q <= hi_mm, any label.
+  [[nodiscard]] ImageMixtureSlice depth_slice(double lo_mm, double hi_mm) const;
+  // The image Gaussians with part label `label` and lo_mm <= d_q <= hi_mm.
+  [[nodiscard]] ImageMixtureSlice label_slice(int label, double lo_mm, double hi_mm) const;
+
+ private:
+  struct Columns {
+    std::vector<double> u, v, sigma2, depth_mm;
+    void resize(std::size_t n);
+    void set(std::size_t i, const ImageGaussian& g);
+    // [begin, end) narrowed to lo_mm <= d_q <= hi_mm (the range is ordered by depth).
+    [[nodiscard]] ImageMixtureSlice slice(std::size_t begin, std::size_t end, double lo_mm, double hi_mm) const;
+  };
+  Columns by_depth_;
+  Columns by_label_;
+  std::vector<std::size_t> label_begin_;  // label l is by_label_[label_begin_[l], label_begin_[l + 1])
+  std::vector<std::size_t> order_;        // scratch for sorting
+};
+
+}  // namespace handtrack

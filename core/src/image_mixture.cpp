@@ -1,0 +1,88 @@
+#include "handtrack/core/image_mixture.hpp"
+
+#include "handtrack/core/depth_input.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+namespace handtrack {
+
+void ImageMixture::Columns::resize(std::size_t n) {
+  u.resize(n);
+  v.resize(n);
+  sigma2.resize(n);
+  depth_mm.resize(n);
+}
+
+void ImageMixture::Columns::set(std::size_t i, const ImageGaussian& g) {
+  u[i] = g.u;
+  v[i] = g.v;
+  sigma2[i] = g.sigma_px * g.sigma_px;
+  depth_mm[i] = g.depth_mm;
+}
+
+namespace {
+
+// The first element of the sorted [first, first + n) for which `before(element)` is false, like
+// std::partition_point, without branches: each step halves the range with a conditional move,
+// so the ~10 steps over a frame's few hundred leaves cost no mispredictions.
+template <class Before>
+const double* partition_point(const double* first, std::size_t n, Before before) {
+  if (n == 0) return first;
+  while (n > 1) {
+    const std::size_t half = n / 2;
+    first = before(first[half]) ? first + half : first;
+    n -= half;
+  }
+  return first + (before(*first) ? 1 : 0);
+}
+
+}  // namespace
+
+ImageMixtureSlice ImageMixture::Columns::slice(std::size_t begin, std::size_t end, double lo_mm,
+                                               double hi_mm) const {
+  const double* lo = partition_point(depth_mm.data() + begin, end - begin, [&](double d) { return d < lo_mm; });
+  const double* hi = partition_point(lo, static_cast<std::size_t>(depth_mm.data() + end - lo),
+                                     [&](double d) { return d <= hi_mm; });
+  const auto i = static_cast<std::size_t>(lo - depth_mm.data());
+  return {u.data() + i, v.data() + i, sigma2.data() + i, depth_mm.data() + i, static_cast<std::size_t>(hi - lo)};
+}
+
+void ImageMixture::assign(const std::vector<ImageGaussian>& gaussians) {
+  const std::size_t n = gaussians.size();
+  by_depth_.resize(n);
+  by_label_.resize(n);
+  order_.resize(n);
+  std::iota(order_.begin(), order_.end(), std::size_t{0});
+  const auto depth = [&](std::size_t i) { return gaussians[i].depth_mm; };
+  std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return depth(a) < depth(b); });
+  for (std::size_t k = 0; k < n; ++k) by_depth_.set(k, gaussians[order_[k]]);
+
+  // By label, then depth (std::sort: no allocation, unlike std::stable_sort).
+  std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) {
+    const int la = gaussians[a].label;
+    const int lb = gaussians[b].label;
+    return la < lb || (la == lb && depth(a) < depth(b));
+  });
+  int max_label = 0;
+  if (n > 0) max_label = std::max(max_label, gaussians[order_[n - 1]].label);
+  label_begin_.assign(static_cast<std::size_t>(max_label) + 2, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const ImageGaussian& g = gaussians[order_[k]];
+    by_label_.set(k, g);
+    ++label_begin_[static_cast<std::size_t>(g.label) + 1];
+  }
+  std::partial_sum(label_begin_.begin(), label_begin_.end(), label_begin_.begin());
+}
+
+ImageMixtureSlice ImageMixture::depth_slice(double lo_mm, double hi_mm) const {
+  return by_depth_.slice(0, size(), lo_mm, hi_mm);
+}
+
+ImageMixtureSlice ImageMixture::label_slice(int label, double lo_mm, double hi_mm) const {
+  if (label < 0 || static_cast<std::size_t>(label) + 1 >= label_begin_.size()) return {};
+  const auto l = static_cast<std::size_t>(label);
+  return by_label_.slice(label_begin_[l], label_begin_[l + 1], lo_mm, hi_mm);
+}
+
+}  // namespace handtrack

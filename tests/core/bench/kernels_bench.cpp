@@ -1,0 +1,183 @@
+// handtrack-kernels-bench: Google Benchmark micro-benchmarks of the tracker's kernels (issue 7) on
+// realistic inputs: seven synthetic 320x240 frames (one per Dexter 1 motion, noise and a body
+// behind the hand) and eight poses per frame near and off the true pose (energy_cases.hpp).
+//
+//   preprocessing   DepthInputBuilder::build without and with the part forest, the forest alone
+//   E_sim           energy + gradient per factor, the optimised term and the plain reference
+//   E               PoseEnergy::evaluate (posing the model, every term, the chain rule)
+//   optimizer       one iteration of the adaptive gradient ascent (two evaluations), and ten
+//
+// Each iteration takes the next frame or (frame, pose) in turn. --forest FILE (before the
+// --benchmark_* options) picks the part forest; the default is the shipped data/part_forest.htf.
+#include "energy_cases.hpp"
+#include "reference_energy.hpp"
+
+#include "handtrack/core/energy.hpp"
+#include "handtrack/core/optimizer.hpp"
+#include "handtrack/core/part_forest.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace handtrack;
+
+std::string g_forest_path = HANDTRACK_DEFAULT_FOREST;
+constexpr double kLabelRadiusMm = 200.0;  // EnergyWeights' R_i
+
+const std::vector<testing::EnergyCase>& cases() {
+  static const auto all = testing::synthetic_energy_cases(7, 8);
+  return all;
+}
+
+const HandModel& model() {
+  static const HandModel m = HandModel::default_adult();
+  return m;
+}
+
+// Every (frame, pose) with its posed model, for the E_sim kernels alone.
+struct PosedCase {
+  const DepthInput* input;
+  PosedHand hand;
+};
+const std::vector<PosedCase>& posed_cases() {
+  static const auto all = [] {
+    std::vector<PosedCase> out;
+    for (const auto& c : cases()) {
+      for (const auto& pose : c.poses) out.push_back({&c.input, PosedHand(model(), pose)});
+    }
+    return out;
+  }();
+  return all;
+}
+
+const PartForest* forest(benchmark::State& state) {
+  static const std::unique_ptr<PartForest> f = []() -> std::unique_ptr<PartForest> {
+    try {
+      return std::make_unique<PartForest>(PartForest::load(g_forest_path));
+    } catch (const std::exception&) {
+      return nullptr;
+    }
+  }();
+  if (!f) state.SkipWithError(("cannot load the part forest " + g_forest_path).c_str());
+  return f.get();
+}
+
+SimilarityFactor factor_of(const benchmark::State& state) {
+  return state.range(0) == 0 ? SimilarityFactor::kDepth : SimilarityFactor::kLabel;
+}
+
+void BM_Preprocess(benchmark::State& state) {
+  const PixelLabeller* labeller = nullptr;
+  if (state.range(0) == 1 && (labeller = forest(state)) == nullptr) return;
+  std::vector<HandHint> hints;
+  for (const auto& c : cases()) hints.push_back(testing::hint_from_pose(c.truth));
+  DepthInputBuilder builder;
+  size_t i = 0;
+  for (auto _ : state) {
+    const DepthInput& in = builder.build(cases()[i].frame.depth, hints[i], labeller);
+    benchmark::DoNotOptimize(in.self_similarity);
+    i = (i + 1) % cases().size();
+  }
+}
+BENCHMARK(BM_Preprocess)->ArgName("forest")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+void BM_ForestLabels(benchmark::State& state) {
+  const PartForest* f = forest(state);
+  if (f == nullptr) return;
+  std::vector<uint8_t> labels;
+  size_t i = 0;
+  for (auto _ : state) {
+    f->label(cases()[i].input, labels);
+    benchmark::DoNotOptimize(labels.data());
+    i = (i + 1) % cases().size();
+  }
+}
+BENCHMARK(BM_ForestLabels)->Unit(benchmark::kMicrosecond);
+
+// E_sim and its gradient for one posed model: the optimised term (Arg 0 depth, 1 label factor).
+void BM_Similarity(benchmark::State& state) {
+  const SimilarityTerm term(factor_of(state), kLabelRadiusMm);
+  size_t i = 0;
+  for (auto _ : state) {
+    const auto& c = posed_cases()[i];
+    PoseGradient g = PoseGradient::Zero();
+    benchmark::DoNotOptimize(term.evaluate(model(), c.hand, *c.input, &g));
+    benchmark::DoNotOptimize(g.data());
+    i = (i + 1) % posed_cases().size();
+  }
+}
+BENCHMARK(BM_Similarity)->ArgName("label")->Arg(0)->Arg(1);
+
+// The same with the plain reference (every pair, libm exp, the chain one point at a time).
+void BM_SimilarityReference(benchmark::State& state) {
+  const SimilarityFactor factor = factor_of(state);
+  size_t i = 0;
+  for (auto _ : state) {
+    const auto& c = posed_cases()[i];
+    PoseGradient g = PoseGradient::Zero();
+    benchmark::DoNotOptimize(reference::similarity(model(), c.hand, *c.input, factor, kLabelRadiusMm, &g));
+    benchmark::DoNotOptimize(g.data());
+    i = (i + 1) % posed_cases().size();
+  }
+}
+BENCHMARK(BM_SimilarityReference)->ArgName("label")->Arg(0)->Arg(1);
+
+// The whole energy of eq. 2 with its gradient, as the optimizer calls it (E_smo on).
+void BM_PoseEnergy(benchmark::State& state) {
+  const PoseEnergy energy(factor_of(state), EnergyWeights{});
+  PosedHand hand;
+  size_t i = 0;
+  size_t k = 0;
+  for (auto _ : state) {
+    const auto& c = cases()[i];
+    const EnergyFrame frame{&model(), &c.input, &c.truth, &c.truth};
+    PoseGradient g;
+    benchmark::DoNotOptimize(energy.evaluate(frame, c.poses[k], hand, &g));
+    benchmark::DoNotOptimize(g.data());
+    if (++k == c.poses.size()) {
+      k = 0;
+      i = (i + 1) % cases().size();
+    }
+  }
+}
+BENCHMARK(BM_PoseEnergy)->ArgName("label")->Arg(0)->Arg(1);
+
+// AdaptiveGradientAscent::maximise from a pose off the truth: range(1) iterations (each one
+// evaluation, plus one at the start).
+void BM_Optimizer(benchmark::State& state) {
+  const PoseEnergy energy(factor_of(state), EnergyWeights{});
+  const AdaptiveGradientAscent optimizer;
+  const auto iterations = static_cast<int>(state.range(1));
+  PosedHand scratch;
+  size_t i = 0;
+  for (auto _ : state) {
+    const auto& c = cases()[i];
+    const EnergyFrame frame{&model(), &c.input, &c.truth, &c.truth};
+    benchmark::DoNotOptimize(optimizer.maximise(energy, frame, c.poses.back(), scratch, iterations).energy);
+    i = (i + 1) % cases().size();
+  }
+}
+BENCHMARK(BM_Optimizer)->ArgNames({"label", "iterations"})->Args({0, 1})->Args({0, 10})->Args({1, 10})
+    ->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc >= 3 && std::strcmp(argv[1], "--forest") == 0) {
+    g_forest_path = argv[2];
+    argv[2] = argv[0];
+    argc -= 2;
+    argv += 2;
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,16 @@
+#pragma once
+// The plain reference of E_sim (paper eq. 6) and its gradient: every model Gaussian against every
+// image Gaussian of DepthInput::gaussians, libm exp, the chain rule one point at a time. It is the
+// straightforward implementation SimilarityTerm started from; the optimised term (DepthInput::mixture
+// slices, SIMD pair sums, one pass through the kinematic chain) must give the same values and stay
+// several times faster (test_energy_kernel.cpp, handtrack-kernels-bench).
+
+#include "handtrack/core/energy.hpp"
+
+namespace handtrack::reference {
+
+// E_sim with `factor` kDepth or kLabel; adds dE_sim/dTheta into *gradient when not null.
+double similarity(const HandModel& model, const PosedHand& hand, const DepthInput& input, SimilarityFactor factor,
+                  double label_radius_mm, PoseGradient* gradient);
+
+}  // namespace handtrack::reference
