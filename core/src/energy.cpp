@@ -243,7 +243,8 @@ double SmoothnessTerm::evaluate(const PoseParams& params, const PoseParams& prev
 PoseEnergy::PoseEnergy(SimilarityFactor factor, const EnergyWeights& weights)
     : factor_(factor),
       weights_(weights),
-      similarity_(factor, weights.label_radius_mm),
+      similarity_(factor == SimilarityFactor::kDepthAndLabel ? SimilarityFactor::kDepth : factor, weights.label_radius_mm),
+      label_similarity_(SimilarityFactor::kLabel, weights.label_radius_mm),
       smoothness_(weights.smoothness_translation_per_mm) {}
 
 double PoseEnergy::evaluate(const EnergyFrame& frame, const PoseParams& params, PosedHand& hand,
@@ -259,6 +260,12 @@ double PoseEnergy::evaluate(const EnergyFrame& frame, const PoseParams& params, 
   const bool want = gradient != nullptr;
   EnergyBreakdown e;
   e.similarity = similarity_.evaluate_centres(*frame.model, hand, *frame.input, want ? &g_sim : nullptr);
+  if (factor_ == SimilarityFactor::kDepthAndLabel) {
+    CentreGradients g_label = CentreGradients::Zero(3, n);
+    e.similarity = 0.5 * (e.similarity + label_similarity_.evaluate_centres(*frame.model, hand, *frame.input,
+                                                                            want ? &g_label : nullptr));
+    g_sim = 0.5 * (g_sim + g_label);
+  }
   if (weights_.collision != 0.0) e.collision = collision_.evaluate_centres(*frame.model, hand, want ? &g_col : nullptr);
   if (weights_.limits != 0.0) e.limits = limits_.evaluate(*frame.model, params, want ? &g_lim : nullptr);
   if (weights_.smoothness != 0.0 && frame.previous != nullptr && frame.before_previous != nullptr) {

@@ -38,7 +38,8 @@ PoseTracker::PoseTracker(TrackerConfig config)
     : config_(config),
       model_(HandModel::default_adult(config.scale)),
       energy_(SimilarityFactor::kDepth, config.weights),
-      guided_energy_(SimilarityFactor::kLabel, config.weights),
+      guided_energy_(SimilarityFactor::kDepthAndLabel, config.weights),
+      label_energy_(SimilarityFactor::kLabel, config.weights),
       optimizer_(config.optimizer),
       rng_(config.seed) {}
 
@@ -201,9 +202,8 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
       const bool guided = fuse && i == config_.particles - 1;
       auto r = optimizer_.maximise(guided ? guided_energy_ : energy_, frame, particle, scratch_);
       // Late fusion (Sec. 5): "the pose particle which converges with the best energy value is
-      // chosen". The two energies differ in scale, so every particle is judged by one common
-      // energy: the depth-only E of eq. 2 at its final pose.
-      if (guided) r.energy = energy_.evaluate(frame, r.params, scratch_, nullptr);
+      // chosen". The particles optimise different energies, so each is judged by one common energy.
+      if (fuse) r.energy = common_energy(frame, r.params);
       if (r.energy > best.energy) {
         best = r;
         winner = i;
@@ -239,6 +239,13 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   out.winning_particle = winner;
   out.detection_guided_won = guided_won;
   return out;
+}
+
+double PoseTracker::common_energy(const EnergyFrame& frame, const PoseParams& params) {
+  // E_col, E_lim and E_smo are the same in both energies, so the blend only mixes the two E_sim.
+  const double lambda = config_.fusion_label_weight;
+  return (1.0 - lambda) * energy_.evaluate(frame, params, scratch_, nullptr) +
+         lambda * label_energy_.evaluate(frame, params, scratch_, nullptr);
 }
 
 TrackerOutput PoseTracker::describe(const PoseParams& params, double energy,

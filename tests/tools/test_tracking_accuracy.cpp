@@ -1,59 +1,78 @@
-// The accuracy test of issue 2: the seven synthetic Dexter-1-like motions (300 frames each,
-// 320x240, sensor noise on), depth-only tracking with 2 particles x 10 iterations (Sec. 7's
-// configuration). Asserts what a user would notice: the mean fingertip error, NaN-free poses, and
-// that no sequence is lost for good.
-#include "handtrack/core/tracker.hpp"
+// The accuracy tests of issues 2 and 4: the seven synthetic Dexter-1-like motions (300 frames each,
+// 320x240, sensor noise on) tracked with 2 particles x 10 iterations (Sec. 7's configuration),
+// depth-only and with late fusion (Sec. 5, the shipped part forest), both on the same rendered
+// frames. Asserts what a user would notice: the mean fingertip error, that late fusion is not less
+// accurate than depth-only on any motion, NaN-free poses, and that no sequence is lost for good.
+#include "synthetic_tracking.hpp"
+
 #include "handtrack/eval/scoring.hpp"
-#include "handtrack/synth/synthetic_camera.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cmath>
+#include <array>
 #include <cstdio>
 
 namespace handtrack {
 namespace {
 
-constexpr int kFrames = 300;
-constexpr double kMaxOverallMeanMm = 25.0;  // issue 2, "Done when"
+using testing::kSequenceFrames;
+
+constexpr double kMaxDepthOnlyMeanMm = 25.0;    // issue 2, "Done when"
+constexpr double kMaxLateFusionMeanMm = 15.0;   // issue 4, "Done when"
+// Late fusion may be this much worse than depth-only on one motion and still count as "not worse".
+// Why not 0: the particles draw random extrapolation factors, and another draw alone moves a
+// motion's mean: depth-only with seeds 1-3 gives pinch 5.12-5.95 mm, fingerwave 6.76-9.17 mm,
+// fingercount 12.6-18.8 mm (docs/TRACKER.md, "Late fusion"). 1 mm is above the spread of the easy
+// motions and far below the gains late fusion must show on the closed hands (flexex1 -9 mm).
+constexpr double kNotWorseToleranceMm = 1.0;
 // "Lost for good": at the end of a sequence the tracker must be back on the hand: at least half of
 // the last 60 frames under 30 mm.
 constexpr int kTailFrames = 60;
 constexpr double kTailBoundMm = 30.0;
 
-TEST(TrackingAccuracy, SevenSyntheticMotionsDepthOnly2Particles10Iterations) {
-  TrackerConfig config;
-  config.particles = 2;
-  config.optimizer.iterations = 10;
-  std::vector<eval::SequenceScore> scores;
+void expect_sane(const eval::SequenceScore& s, const char* energy) {
+  EXPECT_EQ(s.nan_poses, 0) << energy << " " << s.name;
+  EXPECT_EQ(s.without_pose, 0) << energy << " " << s.name << ": the hand is always in view";
+  const auto tail_begin = s.per_frame_error_mm.end() - kTailFrames;
+  const auto good = std::count_if(tail_begin, s.per_frame_error_mm.end(), [](double e) { return e < kTailBoundMm; });
+  EXPECT_GE(good, kTailFrames / 2) << energy << " " << s.name << " is lost for good";
+}
+
+TEST(TrackingAccuracy, SevenSyntheticMotionsDepthOnlyAndLateFusion2Particles10Iterations) {
+  const PartForest forest = PartForest::load(testing::shipped_forest_path());
+  std::vector<eval::SequenceScore> depth_only;
+  std::vector<eval::SequenceScore> late_fusion;
   for (const auto motion : synth::kMotionNames) {
-    synth::SynthOptions options;
-    options.motion = std::string(motion);
-    options.frames = kFrames;
-    options.noise = true;
-    options.seed = 7;
-    synth::SyntheticCamera camera(options);
-    Tracker tracker(config);
-    eval::SequenceScorer scorer{std::string(motion)};
+    auto camera = testing::motion_camera(motion);
+    Tracker depth_tracker(testing::paper_config(EnergyMode::kDepthOnly));
+    Tracker fusion_tracker(testing::paper_config(EnergyMode::kLateFusion));
+    eval::SequenceScorer depth_scorer{std::string(motion)};
+    eval::SequenceScorer fusion_scorer{std::string(motion)};
     synth::SynthFrame frame;
-    for (int i = 0; i < kFrames; ++i) {
+    for (int i = 0; i < kSequenceFrames; ++i) {
       camera.render(i, frame);
-      scorer.add(tracker.track(frame.depth), frame.fingertips);
+      depth_scorer.add(depth_tracker.track(frame.depth), frame.fingertips);
+      fusion_scorer.add(fusion_tracker.track(frame.depth, &forest), frame.fingertips);
     }
-    scores.push_back(scorer.finish(0.0));
+    depth_only.push_back(depth_scorer.finish(0.0));
+    late_fusion.push_back(fusion_scorer.finish(0.0));
   }
-  const auto total = eval::overall(scores);
-  std::fputs(eval::format_table(scores, total).c_str(), stdout);
-  EXPECT_LE(total.mean_error_mm, kMaxOverallMeanMm);
-  EXPECT_EQ(total.nan_poses, 0);
-  for (const auto& s : scores) {
-    EXPECT_EQ(s.nan_poses, 0) << s.name;
-    EXPECT_EQ(s.without_pose, 0) << s.name << ": the hand is always in view";
-    const auto tail = std::vector<double>(s.per_frame_error_mm.end() - kTailFrames, s.per_frame_error_mm.end());
-    const auto good = std::count_if(tail.begin(), tail.end(), [](double e) { return e < kTailBoundMm; });
-    EXPECT_GE(good, kTailFrames / 2) << s.name << " is lost for good";
+  const auto depth_total = eval::overall(depth_only);
+  const auto fusion_total = eval::overall(late_fusion);
+  std::printf("depth-only:\n%s\nlate fusion:\n%s", eval::format_table(depth_only, depth_total).c_str(),
+              eval::format_table(late_fusion, fusion_total).c_str());
+
+  EXPECT_LE(depth_total.mean_error_mm, kMaxDepthOnlyMeanMm);
+  EXPECT_LE(fusion_total.mean_error_mm, kMaxLateFusionMeanMm);
+  for (size_t k = 0; k < depth_only.size(); ++k) {
+    expect_sane(depth_only[k], "depth-only");
+    expect_sane(late_fusion[k], "late fusion");
+    EXPECT_LE(late_fusion[k].mean_error_mm, depth_only[k].mean_error_mm + kNotWorseToleranceMm)
+        << late_fusion[k].name << ": late fusion less accurate than depth-only";
   }
+  // Late fusion must be more than one depth-only particle: the detection-guided one has to win.
+  EXPECT_GT(fusion_total.guided_wins, 0);
 }
 
 }  // namespace

@@ -59,22 +59,33 @@ int main(int argc, char** argv) {
   app.add_option("--w-col", config.weights.collision, "w_c, weight of E_col (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
   app.add_option("--w-lim", config.weights.limits, "w_l, weight of E_lim (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
   app.add_option("--w-smo", config.weights.smoothness, "w_s, weight of E_smo (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
+  app.add_option("--fusion-label-weight", config.fusion_label_weight,
+                 "late fusion: label share lambda of the common energy that picks the particle")
+      ->check(CLI::Range(0.0, 1.0));
+  bool oracle_labels = false;
+  app.add_flag("--oracle-labels", oracle_labels,
+               "late fusion with the sequence's ground-truth labels/ instead of the forest (diagnosis)");
   std::string hand_profile;
   app.add_option("--hand-profile", hand_profile, "hand profile (handtrack-calibrate): the user's hand scale (Sec. 6)");
   bool sim_only = false;
   app.add_flag("--sim-only", sim_only, "E_sim only: drop E_col, E_lim and E_smo (ablation of Fig. 6)");
   if (const auto exit_code = tools::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
-  if (energy == "late-fusion" && forest_file.empty()) {
-    return tools::report_error(kProgram, "--energy late-fusion needs --forest MODEL (handtrack-train-forest)", 1);
+  if (energy == "late-fusion" && forest_file.empty() && !oracle_labels) {
+    return tools::report_error(kProgram,
+                               "--energy late-fusion needs --forest MODEL (handtrack-train-forest) or --oracle-labels", 1);
   }
   if (energy == "late-fusion") config.mode = EnergyMode::kLateFusion;
   if (sim_only) config.weights.collision = config.weights.limits = config.weights.smoothness = 0.0;
 
   try {
-    std::optional<PartForest> forest;
     if (!hand_profile.empty()) config.scale = load_hand_profile(hand_profile);
-    if (config.mode == EnergyMode::kLateFusion) forest.emplace(PartForest::load(forest_file));
-    const PixelLabeller* labeller = forest ? &*forest : nullptr;
+    std::optional<PartForest> forest;
+    if (config.mode == EnergyMode::kLateFusion && !oracle_labels) forest.emplace(PartForest::load(forest_file));
+    // --oracle-labels: each frame's labels/NNNNNN.png through FixedLabels, which points at this.
+    std::vector<uint8_t> truth_labels;
+    const FixedLabels oracle(&truth_labels);
+    const PixelLabeller* labeller = forest ? static_cast<const PixelLabeller*>(&*forest) : nullptr;
+    if (config.mode == EnergyMode::kLateFusion && oracle_labels) labeller = &oracle;
     std::vector<eval::SequenceScore> scores;
     std::vector<SequenceReader> readers;
     size_t total_frames = 0;
@@ -82,6 +93,9 @@ int main(int argc, char** argv) {
       readers.emplace_back(d);
       if (!readers.back().has_groundtruth()) {
         throw std::runtime_error(d + ": no groundtruth.csv, nothing to score");
+      }
+      if (oracle_labels && readers.back().frame_count() > 0 && !readers.back().labels(0)) {
+        throw std::runtime_error(d + ": no labels/, needed by --oracle-labels");
       }
       total_frames += readers.back().frame_count();
     }
@@ -93,6 +107,7 @@ int main(int argc, char** argv) {
       double seconds = 0.0;
       for (size_t i = 0; i < reader.frame_count(); ++i) {
         const DepthImage depth = reader.depth(i);
+        if (labeller == &oracle) truth_labels = reader.labels(i).value_or(Gray8Image{}).pixels;
         const auto t0 = std::chrono::steady_clock::now();
         const TrackerOutput out = tracker.track(depth, labeller);
         seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

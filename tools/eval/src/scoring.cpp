@@ -24,6 +24,7 @@ double fingertip_error_mm(const TrackerOutput& out, const Fingertips& truth) {
 void SequenceScorer::add(const TrackerOutput& out, const Fingertips& truth) {
   ++score_.frames;
   if (!out.params.allFinite()) ++score_.nan_poses;
+  if (out.detection_guided_won) ++score_.guided_wins;
   score_.per_frame_error_mm.push_back(fingertip_error_mm(out, truth));
 }
 
@@ -67,6 +68,7 @@ SequenceScore overall(const std::vector<SequenceScore>& sequences) {
   for (const auto& s : sequences) {
     all.frames += s.frames;
     all.nan_poses += s.nan_poses;
+    all.guided_wins += s.guided_wins;
     all.per_frame_error_mm.insert(all.per_frame_error_mm.end(), s.per_frame_error_mm.begin(),
                                   s.per_frame_error_mm.end());
     if (s.fps > 0.0) seconds += s.frames / s.fps;
@@ -79,12 +81,13 @@ SequenceScore overall(const std::vector<SequenceScore>& sequences) {
 std::string format_table(const std::vector<SequenceScore>& sequences, const SequenceScore& total) {
   std::string text;
   char line[160];
-  std::snprintf(line, sizeof line, "%-14s %7s %9s %6s %6s %6s %6s %8s\n", "sequence", "frames", "mean_mm", "<15", "<20",
-                "<25", "<30", "fps");
+  std::snprintf(line, sizeof line, "%-14s %7s %9s %6s %6s %6s %6s %8s %7s\n", "sequence", "frames", "mean_mm", "<15",
+                "<20", "<25", "<30", "fps", "guided");
   text += line;
   const auto row = [&](const SequenceScore& s) {
-    std::snprintf(line, sizeof line, "%-14s %7d %9.2f %6.1f %6.1f %6.1f %6.1f %8.1f\n", s.name.c_str(), s.frames,
-                  s.mean_error_mm, s.pct_below[0], s.pct_below[1], s.pct_below[2], s.pct_below[3], s.fps);
+    std::snprintf(line, sizeof line, "%-14s %7d %9.2f %6.1f %6.1f %6.1f %6.1f %8.1f %7d\n", s.name.c_str(), s.frames,
+                  s.mean_error_mm, s.pct_below[0], s.pct_below[1], s.pct_below[2], s.pct_below[3], s.fps,
+                  s.guided_wins);
     text += line;
   };
   for (const auto& s : sequences) row(s);
@@ -107,6 +110,7 @@ nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const Sequen
                                 {"frames_scored", s.scored},
                                 {"frames_without_pose", s.without_pose},
                                 {"nan_poses", s.nan_poses},
+                                {"detection_guided_wins", s.guided_wins},
                                 {"mean_fingertip_error_mm", number(s.mean_error_mm)},
                                 {"max_fingertip_error_mm", number(s.max_error_mm)},
                                 {"pct_frames_below_mm", pct(s)},
@@ -116,6 +120,7 @@ nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const Sequen
                     {"frames_scored", total.scored},
                     {"frames_without_pose", total.without_pose},
                     {"nan_poses", total.nan_poses},
+                    {"detection_guided_wins", total.guided_wins},
                     {"mean_fingertip_error_mm", number(total.mean_error_mm)},
                     {"pct_frames_below_mm", pct(total)},
                     {"fps", total.fps}};

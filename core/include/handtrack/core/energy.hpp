@@ -31,6 +31,10 @@ struct EnergyWeights {
 enum class SimilarityFactor {
   kDepth,  // Delta(p,q) = max(0, 1 - |d_p - d_q| / (2 sigma_h))                        (eq. 7)
   kLabel,  // Delta_l(p,q) = [l_p = l_q] max(0, 1 - |d_p - d_q| / (2 R_i))            (Sec. 4.3)
+  // The detection-guided energy read as "an augmented version of the depth-only energy" (Sec. 1):
+  // E_sim = 0.5 (E_sim[Delta] + E_sim[Delta_l]); the mean keeps E_sim on the scale of eq. 2, so
+  // w_c, w_l and w_s keep their balance. PoseEnergy sums two SimilarityTerms for it.
+  kDepthAndLabel,
 };
 
 // E_sim = 1/E(C_I,C_I) * sum_{p in C_p} sum_{q in C_I} Delta(p,q) D_pq                  (eq. 6)
@@ -119,6 +123,7 @@ class PoseEnergy {
   SimilarityFactor factor_;
   EnergyWeights weights_;
   SimilarityTerm similarity_;
+  SimilarityTerm label_similarity_;  // kDepthAndLabel only: the second half of E_sim
   CollisionTerm collision_;
   JointLimitTerm limits_;
   SmoothnessTerm smoothness_;

@@ -26,6 +26,7 @@ struct SequenceScore {
   int scored = 0;              // frames with annotations and a pose
   int without_pose = 0;        // annotated frames where the tracker reported no hand
   int nan_poses = 0;           // frames whose pose had a non-finite number (must stay 0)
+  int guided_wins = 0;         // late fusion: frames the detection-guided particle won
   double mean_error_mm = 0.0;  // over scored frames
   double max_error_mm = 0.0;
   std::array<double, kThresholdsMm.size()> pct_below{};  // over annotated frames

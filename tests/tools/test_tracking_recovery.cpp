@@ -1,0 +1,147 @@
+// Recovery (issue 4): frames without a hand say so and carry no pose, a hand that comes back is
+// tracked again, and (not yet passing, see below) a gross error is repaired within half a second.
+#include "synthetic_tracking.hpp"
+
+#include "handtrack/core/kinematics.hpp"
+#include "handtrack/eval/scoring.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <random>
+
+namespace handtrack {
+namespace {
+
+using testing::kSequenceFrames;
+
+// Recovery: the knocked-off tracker is knocked off after each of these frames (slow and fast half).
+constexpr std::array<int, 3> kKnockFrames = {60, 140, 220};
+constexpr double kKnockRotationRad = 1.6;
+// "Back under 20 mm within 30 frames" (issue 4): half a second at the synthetic camera's 60 fps.
+// Where the tracker that was not knocked off is itself above 20 mm (the fists of fingercount's
+// first 100 frames and of flexex1: the limit of our model, docs/TRACKER.md), "back" means as
+// close as that tracker, within kBackAsCloseMm.
+constexpr int kRecoveryFrames = 30;
+constexpr double kRecoveredMm = 20.0;
+constexpr double kBackAsCloseMm = 2.0;
+
+// The gross error: the hand turned by 1.6 rad about a random axis through the wrist, and every
+// joint angle drawn uniformly within its limits.
+PoseParams knocked_off(const PoseParams& pose, const HandModel& model, std::mt19937_64& rng) {
+  std::normal_distribution<double> normal;
+  const Eigen::Vector3d axis = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+  PoseParams out = pose;
+  out.segment<3>(kRotationParam) =
+      rotation_log(rotation_exp(kKnockRotationRad * axis) * rotation_exp(pose.segment<3>(kRotationParam)));
+  for (int j = 0; j < kNumJointAngles; ++j) {
+    const auto& limit = model.limits()[static_cast<size_t>(j)];
+    out[kFirstAngleParam + j] = std::uniform_real_distribution<double>(limit.lo, limit.hi)(rng);
+  }
+  return out;
+}
+
+// Frames from each knock until the knocked-off tracker is back (-1: not within kRecoveryFrames).
+std::vector<int> frames_to_recover(const std::vector<double>& knocked_mm, const std::vector<double>& undisturbed_mm) {
+  std::vector<int> out;
+  for (const int knock : kKnockFrames) {
+    int back = -1;
+    for (int i = knock + 1; i <= knock + kRecoveryFrames && back < 0; ++i) {
+      const auto k = static_cast<size_t>(i);
+      if (knocked_mm[k] < kRecoveredMm || knocked_mm[k] <= undisturbed_mm[k] + kBackAsCloseMm) back = i - knock;
+    }
+    out.push_back(back);
+  }
+  return out;
+}
+
+// Tracks every motion with late fusion twice on the same frames, once knocked off after each of
+// kKnockFrames. DISABLED: it does not pass yet (measured: 14 of 21 knocks repaired; the tracker
+// notices a lost fit only by its confidence, below 0.3 for 3 frames, and a knocked-off pose that
+// still covers the hand's outline keeps a higher confidence and drifts back slowly or not at all).
+// Run it with --gtest_also_run_disabled_tests.
+TEST(TrackingRecovery, DISABLED_BackWithin30FramesAfterAGrossError) {
+  const PartForest forest = PartForest::load(testing::shipped_forest_path());
+  std::mt19937_64 rng(4);
+  for (const auto motion : synth::kMotionNames) {
+    auto camera = testing::motion_camera(motion);
+    Tracker undisturbed(testing::paper_config(EnergyMode::kLateFusion));
+    Tracker knocked(testing::paper_config(EnergyMode::kLateFusion));
+    std::vector<double> undisturbed_mm;
+    std::vector<double> knocked_mm;
+    synth::SynthFrame frame;
+    for (int i = 0; i < kSequenceFrames; ++i) {
+      camera.render(i, frame);
+      undisturbed_mm.push_back(eval::fingertip_error_mm(undisturbed.track(frame.depth, &forest), frame.fingertips));
+      const auto out = knocked.track(frame.depth, &forest);
+      knocked_mm.push_back(eval::fingertip_error_mm(out, frame.fingertips));
+      if (std::find(kKnockFrames.begin(), kKnockFrames.end(), i) != kKnockFrames.end()) {
+        auto& pose = knocked.pose_tracker();
+        pose.override_pose(knocked_off(out.params, pose.model(), rng));
+      }
+    }
+    const auto recovered = frames_to_recover(knocked_mm, undisturbed_mm);
+    for (size_t n = 0; n < recovered.size(); ++n) {
+      std::printf("%-12s knocked off after frame %3d: back after %d frames\n", std::string(motion).c_str(),
+                  kKnockFrames[n], recovered[n]);
+      EXPECT_GE(recovered[n], 1) << motion << " knocked off after frame " << kKnockFrames[n]
+                                 << " is not back within 30 frames";
+    }
+  }
+}
+
+// No hand: the state says so, and every number of the pose is zero (nothing invented).
+void expect_no_hand(const TrackerOutput& out, const std::string& what) {
+  EXPECT_EQ(out.state, TrackingState::kNoHand) << what;
+  EXPECT_TRUE(out.params.isZero()) << what;
+  for (const auto& tip : out.fingertips) EXPECT_TRUE(tip.isZero()) << what;
+  for (const auto& joint : out.joints) EXPECT_TRUE(joint.isZero()) << what;
+  EXPECT_EQ(out.confidence, 0.0) << what;
+}
+
+TEST(TrackingRecovery, EmptySceneIsNoHand) {
+  Tracker tracker(testing::paper_config(EnergyMode::kDepthOnly));
+  DepthImage empty = testing::motion_camera("pinch").render(0).depth;
+  std::fill(empty.depth_mm.begin(), empty.depth_mm.end(), 0.0F);
+  for (int i = 0; i < 3; ++i) expect_no_hand(tracker.track(empty), "empty frame " + std::to_string(i));
+}
+
+// The hand backs away beyond the working volume (far plane 600 mm, Sec. 4) and comes back.
+TEST(TrackingRecovery, HandLeavingTheWorkingVolumeIsNoHandAndIsFoundAgain) {
+  constexpr int kApproachFrames = 30;   // tracked in place first
+  constexpr double kStepMm = 15.0;      // away per frame, then back
+  constexpr int kAwayFrames = 40;       // 600 mm further: the whole hand (and forearm) beyond 600 mm
+  constexpr int kTotalFrames = kApproachFrames + 2 * kAwayFrames + kRecoveryFrames;
+  const PartForest forest = PartForest::load(testing::shipped_forest_path());
+  Tracker tracker(testing::paper_config(EnergyMode::kLateFusion));
+  auto camera = testing::motion_camera("fingerwave");
+  const double far_mm = tracker.pose_tracker().config().input.far_mm;
+  const double near_mm = tracker.pose_tracker().config().input.near_mm;
+  synth::SynthFrame frame;
+  int no_hand_frames = 0;
+  int first_back_under_20mm = -1;
+  for (int i = 0; i < kTotalFrames; ++i) {
+    const int away = std::clamp(std::min(i - kApproachFrames, kApproachFrames + 2 * kAwayFrames - i), 0, kAwayFrames);
+    auto pose = camera.pose(i);
+    pose.translation_mm.z() += kStepMm * away;
+    camera.render_pose(pose, i, frame);
+    const auto out = tracker.track(frame.depth, &forest);
+    const bool any_depth_in_volume = std::any_of(frame.depth.depth_mm.begin(), frame.depth.depth_mm.end(),
+                                                 [&](float d) { return d >= near_mm && d <= far_mm; });
+    if (!any_depth_in_volume) {
+      expect_no_hand(out, "frame " + std::to_string(i) + ": nothing inside the working volume");
+      ++no_hand_frames;
+    }
+    if (i >= kApproachFrames + 2 * kAwayFrames && first_back_under_20mm < 0 &&
+        eval::fingertip_error_mm(out, frame.fingertips) < kRecoveredMm) {
+      first_back_under_20mm = i;
+    }
+  }
+  EXPECT_GT(no_hand_frames, 0) << "the hand never left the working volume: the test moves it too little";
+  EXPECT_GE(first_back_under_20mm, 0) << "the hand is back in place but not tracked within 30 frames";
+}
+
+}  // namespace
+}  // namespace handtrack
