@@ -2,11 +2,14 @@
 
 #include "handtrack/core/hand_model.hpp"
 
+#include "fast_exp.hpp"
+
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 namespace handtrack {
 namespace {
@@ -83,29 +86,92 @@ const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::o
 }
 
 void DepthInputBuilder::median_filter(const DepthImage& depth) {
+  const int r = config_.median_radius_px;
+  out_.filtered_mm.resize(depth.depth_mm.size());
+  unclamped_mm_.resize(depth.depth_mm.size());
+  if (r == 1) {
+    median_3x3(depth);
+  } else {
+    median_any(depth);
+  }
+  const auto near = static_cast<float>(config_.near_mm);
+  const auto far = static_cast<float>(config_.far_mm);
+  for (size_t i = 0; i < unclamped_mm_.size(); ++i) {
+    const float m = unclamped_mm_[i];
+    out_.filtered_mm[i] = (m >= near && m <= far) ? m : 0.0F;
+  }
+}
+
+// The 3x3 median as the median of three column-sorted triples (Paeth, "Median finding on a 3x3
+// grid", Graphics Gems 1990): with every column of the window sorted into (lo, mid, hi),
+//   median = med3(max(lo_1, lo_2, lo_3), med3(mid_1, mid_2, mid_3), min(hi_1, hi_2, hi_3)).
+// Branch-free min/max over rows, which the compiler vectorises. Borders repeat the edge pixel.
+void DepthInputBuilder::median_3x3(const DepthImage& depth) {
+  const int w = depth.width();
+  const int h = depth.height();
+  // Non-finite samples count as 0 (no depth).
+  clean_.resize(depth.depth_mm.size());
+  for (size_t i = 0; i < clean_.size(); ++i) {
+    const float d = depth.depth_mm[i];
+    clean_[i] = std::abs(d) <= std::numeric_limits<float>::max() ? d : 0.0F;
+  }
+  const auto row = [&](int v) { return clean_.data() + static_cast<size_t>(std::clamp(v, 0, h - 1)) * w; };
+  // Column triples of the current window rows, padded by one column on each side.
+  lo_.resize(static_cast<size_t>(w) + 2);
+  mid_.resize(static_cast<size_t>(w) + 2);
+  hi_.resize(static_cast<size_t>(w) + 2);
+  float* __restrict lo = lo_.data();
+  float* __restrict mid = mid_.data();
+  float* __restrict hi = hi_.data();
+  for (int v = 0; v < h; ++v) {
+    const float* __restrict a = row(v - 1);
+    const float* __restrict b = row(v);
+    const float* __restrict c = row(v + 1);
+    sort_columns(a, b, c, w, lo + 1, mid + 1, hi + 1);
+    lo[0] = lo[1];
+    mid[0] = mid[1];
+    hi[0] = hi[1];
+    lo[w + 1] = lo[w];
+    mid[w + 1] = mid[w];
+    hi[w + 1] = hi[w];
+    float* __restrict out = unclamped_mm_.data() + static_cast<size_t>(v) * w;
+    for (int u = 0; u < w; ++u) {
+      const float max_lo = std::max(std::max(lo[u], lo[u + 1]), lo[u + 2]);
+      const float min_hi = std::min(std::min(hi[u], hi[u + 1]), hi[u + 2]);
+      const float med_mid = std::max(std::min(mid[u], mid[u + 1]), std::min(std::max(mid[u], mid[u + 1]), mid[u + 2]));
+      out[u] = std::max(std::min(max_lo, med_mid), std::min(std::max(max_lo, med_mid), min_hi));
+    }
+  }
+}
+
+void DepthInputBuilder::sort_columns(const float* __restrict a, const float* __restrict b, const float* __restrict c,
+                                     int n, float* __restrict lo, float* __restrict mid, float* __restrict hi) {
+  for (int u = 0; u < n; ++u) {
+    const float ab_lo = std::min(a[u], b[u]);
+    const float ab_hi = std::max(a[u], b[u]);
+    lo[u] = std::min(ab_lo, c[u]);
+    hi[u] = std::max(ab_hi, c[u]);
+    mid[u] = std::max(ab_lo, std::min(ab_hi, c[u]));
+  }
+}
+
+// Any other radius: sort each (2r+1)^2 window (r = 0 copies).
+void DepthInputBuilder::median_any(const DepthImage& depth) {
   const int w = depth.width();
   const int h = depth.height();
   const int r = config_.median_radius_px;
-  out_.filtered_mm.assign(depth.depth_mm.size(), 0.0F);
-  unclamped_mm_.assign(depth.depth_mm.size(), 0.0F);
-  const auto near = static_cast<float>(config_.near_mm);
-  const auto far = static_cast<float>(config_.far_mm);
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       window_.clear();
       for (int dv = -r; dv <= r; ++dv) {
         for (int du = -r; du <= r; ++du) {
-          const int uu = std::clamp(u + du, 0, w - 1);
-          const int vv = std::clamp(v + dv, 0, h - 1);
-          const float d = depth.at(uu, vv);
+          const float d = depth.at(std::clamp(u + du, 0, w - 1), std::clamp(v + dv, 0, h - 1));
           window_.push_back(std::isfinite(d) ? d : 0.0F);
         }
       }
       const auto mid = window_.begin() + static_cast<std::ptrdiff_t>(window_.size() / 2);
       std::nth_element(window_.begin(), mid, window_.end());
-      const float m = *mid;
-      out_.filtered_mm[static_cast<size_t>(v) * w + u] = (m >= near && m <= far) ? m : 0.0F;
-      unclamped_mm_[static_cast<size_t>(v) * w + u] = m;
+      unclamped_mm_[static_cast<size_t>(v) * w + u] = *mid;
     }
   }
 }
@@ -133,31 +199,39 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
     wrist = hint->wrist_mm;
     found = true;
   }
-  // Keeps pixels near `centre` and above the wrist plane; returns how many.
-  // Keeps the pixels near `centre` and above the forearm cut. The cut is the wrist plane, but never
-  // lower than one (generous) hand length below the farthest point along the axis: a wrist that
-  // drifted down the forearm must not let the forearm in, or the model follows it further down.
+  // Keeps the pixels near `centre` and above the forearm cut, and lists them in selected_. The cut
+  // is the wrist plane, but never lower than one (generous) hand length below the farthest point
+  // along the axis: a wrist that drifted down the forearm must not let the forearm in, or the model
+  // follows it further down. Returns how many pixels it kept.
   const auto select = [&]() {
+    std::fill(out_.hand_mask.begin(), out_.hand_mask.end(), 0);
+    selected_.clear();
+    along_axis_.clear();
     double tip = -std::numeric_limits<double>::infinity();
-    for (size_t i = 0; i < n; ++i) {
-      out_.hand_mask[i] = 0;
-      if (d[i] <= 0.0F) continue;
-      const Vector3d p = point(i);
-      if ((p - centre).squaredNorm() > hand_radius * hand_radius) continue;
-      out_.hand_mask[i] = 1;
-      tip = std::max(tip, p.dot(axis));
+    // Unprojection by ray: p = (r_u d, r_v d, d) with r_u = (u - c_x) / f_x, r_v = (v - c_y) / f_y.
+    ray_u_.resize(static_cast<size_t>(w));
+    for (int u = 0; u < w; ++u) ray_u_[static_cast<size_t>(u)] = (u - cam.cx) / cam.fx;
+    for (int v = 0; v < h; ++v) {
+      const double ray_v = (v - cam.cy) / cam.fy;
+      const float* row = d.data() + static_cast<size_t>(v) * w;
+      for (int u = 0; u < w; ++u) {
+        if (row[u] <= 0.0F) continue;
+        const Vector3d p(ray_u_[static_cast<size_t>(u)] * row[u], ray_v * row[u], row[u]);
+        if ((p - centre).squaredNorm() > hand_radius * hand_radius) continue;
+        selected_.push_back(v * w + u);
+        along_axis_.push_back(p.dot(axis));
+        tip = std::max(tip, along_axis_.back());
+      }
     }
     const double cut = std::max(wrist.dot(axis) - kWristCutMarginMm, tip - kHandLengthMargin * config_.hand_length_mm);
-    int count = 0;
-    for (size_t i = 0; i < n; ++i) {
-      if (!out_.hand_mask[i]) continue;
-      if (point(i).dot(axis) < cut) {
-        out_.hand_mask[i] = 0;
-        continue;
-      }
-      ++count;
+    size_t kept = 0;
+    for (size_t k = 0; k < selected_.size(); ++k) {
+      if (along_axis_[k] < cut) continue;
+      out_.hand_mask[static_cast<size_t>(selected_[k])] = 1;
+      selected_[kept++] = selected_[k];
     }
-    return count;
+    selected_.resize(kept);
+    return static_cast<int>(kept);
   };
   const auto area_mm2 = [&](int pixels, double depth_mm) { return pixels * depth_mm * depth_mm / (cam.fx * cam.fy); };
 
@@ -289,9 +363,7 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
   out_.finger_axis = axis;
   out_.palm_centre_mm = centre;
   Vector3d sum = Vector3d::Zero();
-  for (size_t i = 0; i < n; ++i) {
-    if (out_.hand_mask[i]) sum += point(i);
-  }
+  for (const int i : selected_) sum += point(static_cast<size_t>(i));
   out_.hand_centroid_mm = count > 0 ? Vector3d(sum / count) : centre;
   if (area_mm2(count, out_.hand_centroid_mm.z()) < config_.min_hand_area_mm2) {
     std::fill(out_.hand_mask.begin(), out_.hand_mask.end(), 0);
@@ -339,14 +411,13 @@ void DepthInputBuilder::build_quadtree() {
   int v0 = h;
   int u1 = -1;
   int v1 = -1;
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      if (!out_.hand_mask[static_cast<size_t>(v) * w + u]) continue;
-      u0 = std::min(u0, u);
-      v0 = std::min(v0, v);
-      u1 = std::max(u1, u);
-      v1 = std::max(v1, v);
-    }
+  for (const int i : selected_) {
+    const int u = i % w;
+    const int v = i / w;
+    u0 = std::min(u0, u);
+    v0 = std::min(v0, v);
+    u1 = std::max(u1, u);
+    v1 = std::max(v1, v);
   }
   for (int y = (v0 / root) * root; y <= v1; y += root) {
     for (int x = (u0 / root) * root; x <= u1; x += root) quad(x, y, root, min_leaf);
@@ -414,15 +485,41 @@ void FixedLabels::label(const DepthInput& input, std::vector<uint8_t>& labels) c
 }
 
 double image_self_similarity(const std::vector<ImageGaussian>& gaussians) {
-  double e = 0.0;
-  for (const auto& a : gaussians) {
-    for (const auto& b : gaussians) {
-      const double du = a.u - b.u;
-      const double dv = a.v - b.v;
-      e += overlap_2d(du * du + dv * dv, a.sigma_px, b.sigma_px);
+  // E(C_I,C_I) = sum_p sum_q D_pq, D_pq = 2 pi s_p^2 s_q^2 / S exp(-|mu_p - mu_q|^2 / 2S),
+  // S = s_p^2 + s_q^2 (eq. 3, unit weights): D_pp = pi s_p^2 and D_pq = D_qp, so each unordered pair
+  // is summed once and counted twice. Pairs with |mu_p - mu_q|^2 / 2S > kCutoff add less than
+  // e^-kCutoff of their peak and are skipped; sorted by u, the sweep over q stops where even the
+  // widest partner is out of reach.
+  constexpr double kCutoff = 25.0;
+  struct Leaf {
+    double u, v, s2;
+  };
+  thread_local std::vector<Leaf> leaves;  // reused: no allocation once grown
+  leaves.clear();
+  double s2_max = 0.0;
+  for (const auto& g : gaussians) {
+    leaves.push_back({g.u, g.v, g.sigma_px * g.sigma_px});
+    s2_max = std::max(s2_max, leaves.back().s2);
+  }
+  std::sort(leaves.begin(), leaves.end(), [](const Leaf& a, const Leaf& b) { return a.u < b.u; });
+  double diagonal = 0.0;
+  double pairs = 0.0;
+  for (size_t p = 0; p < leaves.size(); ++p) {
+    const Leaf& a = leaves[p];
+    diagonal += std::numbers::pi * a.s2;
+    const double reach2 = 2.0 * kCutoff * (a.s2 + s2_max);
+    for (size_t q = p + 1; q < leaves.size(); ++q) {
+      const Leaf& b = leaves[q];
+      const double du = b.u - a.u;
+      if (du * du > reach2) break;
+      const double dv = b.v - a.v;
+      const double dist2 = du * du + dv * dv;
+      const double s = a.s2 + b.s2;
+      if (dist2 > 2.0 * kCutoff * s) continue;
+      pairs += a.s2 * b.s2 / s * detail::exp_nonpositive(-dist2 / (2.0 * s));
     }
   }
-  return e;
+  return diagonal + 2.0 * 2.0 * std::numbers::pi * pairs;
 }
 
 }  // namespace handtrack

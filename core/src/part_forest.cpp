@@ -415,6 +415,10 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
   // reused (no allocation once it has grown).
   int x0 = w, y0 = h, x1 = -1, y1 = -1;
   for (int y = 0; y < h; ++y) {
+    const uint8_t* row = mask + at(0, y);
+    uint8_t any = 0;
+    for (int x = 0; x < w; ++x) any |= row[x];  // most rows have no hand: one vectorised pass
+    if (any == 0) continue;
     for (int x = 0; x < w; ++x) {
       if (!usable(at(x, y))) continue;
       x0 = std::min(x0, x);
@@ -465,16 +469,17 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
     if (pending == kBatch) flush();
   };
   if (stride == 1) {
-    for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) {
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
         if (usable(at(x, y))) add(x, y, x, y);
       }
     }
   } else {
-    // One site per block: its centre when that is on the hand, else its first hand pixel.
-    for (int by = 0; by < h; by += stride) {
+    // One site per block of the image's stride grid that meets the hand's bounding box: its centre
+    // when that is on the hand, else its first hand pixel.
+    for (int by = y0 - y0 % stride; by <= y1; by += stride) {
       const int ye = std::min(h, by + stride);
-      for (int bx = 0; bx < w; bx += stride) {
+      for (int bx = x0 - x0 % stride; bx <= x1; bx += stride) {
         const int xe = std::min(w, bx + stride);
         int sx = std::min(bx + stride / 2, xe - 1);
         int sy = std::min(by + stride / 2, ye - 1);

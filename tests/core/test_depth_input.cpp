@@ -1,5 +1,6 @@
 // Property tests of the depth input (Sec. 3.1): working volume, segmentation, quadtree leaves.
 #include "handtrack/core/depth_input.hpp"
+#include "handtrack/core/hand_model.hpp"
 #include "handtrack/core/kinematics.hpp"
 
 #include <gtest/gtest.h>
@@ -84,6 +85,25 @@ TEST(DepthInput, QuadtreeLeavesAreFlatDisjointAndMeanDepthAt320And640) {
   }
 }
 
+// E(C_I,C_I) skips pairs that are too far apart to matter: it must equal the plain double sum of
+// eq. 3 over all pairs.
+TEST(DepthInput, SelfSimilarityEqualsTheFullPairSum) {
+  for (const int width : {320, 640}) {
+    DepthInputConfig cfg;
+    cfg.quadtree_threshold_mm = 2.0;  // many leaves of every size
+    DepthInputBuilder builder(cfg);
+    const auto& in = builder.build(blob_scene(camera(width, width * 3 / 4), 420, true), std::nullopt);
+    ASSERT_GT(in.gaussians.size(), 100U);
+    double full = 0.0;
+    for (const auto& a : in.gaussians) {
+      for (const auto& b : in.gaussians) {
+        full += overlap_2d((a.u - b.u) * (a.u - b.u) + (a.v - b.v) * (a.v - b.v), a.sigma_px, b.sigma_px);
+      }
+    }
+    EXPECT_NEAR(in.self_similarity, full, 1e-9 * full) << "width " << width;
+  }
+}
+
 TEST(DepthInput, SteepSurfacesSplitFinerThanFlatOnes) {
   const auto cam = camera(320, 240);
   DepthImage flat{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 0.0F)};
@@ -149,6 +169,42 @@ TEST(DepthInput, MedianFilterRemovesFlyingPixels) {
   for (const auto& g : in.gaussians) EXPECT_GT(g.depth_mm, 370.0);
 }
 
+
+// The 3x3 filter is exact: every pixel equals the median of its clamped 3x3 window (non-finite
+// samples count as 0), on noise with NaNs and infinities, at both resolutions.
+TEST(DepthInput, MedianFilterIsTheExactWindowMedian) {
+  for (const int width : {320, 641}) {
+    CameraIntrinsics cam = camera(width, width * 3 / 4);
+    DepthImage img{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height)};
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> depth(100.0F, 700.0F);
+    std::uniform_int_distribution<int> special(0, 49);
+    for (float& d : img.depth_mm) {
+      const int s = special(rng);
+      d = s == 0 ? NAN : s == 1 ? INFINITY : s == 2 ? 0.0F : depth(rng);
+    }
+    DepthInputConfig cfg;
+    cfg.near_mm = 0.0;
+    cfg.far_mm = 1e9;
+    DepthInputBuilder builder(cfg);
+    const auto& in = builder.build(img, std::nullopt);
+    int mismatches = 0;
+    for (int v = 0; v < cam.height; ++v) {
+      for (int u = 0; u < cam.width; ++u) {
+        std::vector<float> window;
+        for (int dv = -1; dv <= 1; ++dv) {
+          for (int du = -1; du <= 1; ++du) {
+            const float d = img.at(std::clamp(u + du, 0, cam.width - 1), std::clamp(v + dv, 0, cam.height - 1));
+            window.push_back(std::isfinite(d) ? d : 0.0F);
+          }
+        }
+        std::sort(window.begin(), window.end());
+        mismatches += in.filtered_mm[static_cast<size_t>(v) * cam.width + u] != window[4] ? 1 : 0;
+      }
+    }
+    EXPECT_EQ(mismatches, 0) << "width " << width;
+  }
+}
 TEST(DepthInput, ForearmIsCutAtTheWrist) {
   const auto cam = camera(320, 240);
   const DepthImage img = blob_scene(cam, 400, true);

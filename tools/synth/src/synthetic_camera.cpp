@@ -77,12 +77,15 @@ struct SyntheticCamera::State {
   Motion motion;
   Raycaster raycaster;
   std::vector<ConeSphere> primitives;
+  // The static scene, drawn once into `background`; each frame starts from a copy of it and draws
+  // the hand (a z-buffer does not care about the order).
   std::vector<PlanePatch> planes;
   std::vector<ConeSphere> background_solids;
+  Raycaster background;
 
   State(SynthOptions o, const HandShape& s)
       : options(std::move(o)), shape(s), motion(options.motion, options.frames, options.camera.fps, shape),
-        raycaster(options.camera) {}
+        raycaster(options.camera), background(options.camera) {}
 
   void apply_noise(int frame, SynthFrame& out) const;
 };
@@ -121,6 +124,9 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
       s.planes.push_back(make_patch({0, 250, 750}, {0.0, -1.0, -0.5}, 0.0, 0.0));
       break;
   }
+  s.background.clear();
+  for (const auto& p : s.background_solids) s.background.draw(p);
+  for (const auto& p : s.planes) s.background.draw(p);
 }
 
 SyntheticCamera::~SyntheticCamera() = default;
@@ -151,11 +157,8 @@ void SyntheticCamera::render_pose(const HandPose& pose, int frame, SynthFrame& o
   out.fingertips = fingertips_from_joints(out.joints);
 
   posed_primitives(s.shape, out.pose, out.joints, s.primitives);
-  s.raycaster.clear();
-  // Near things first so that early z rejection skips most of the far ones.
+  s.raycaster = s.background;  // same sizes: no allocation
   for (const auto& p : s.primitives) s.raycaster.draw(p);
-  for (const auto& p : s.background_solids) s.raycaster.draw(p);
-  for (const auto& p : s.planes) s.raycaster.draw(p);
 
   const size_t n = static_cast<size_t>(cam.width) * static_cast<size_t>(cam.height);
   out.depth.camera = cam;

@@ -200,7 +200,8 @@ int main(int argc, char** argv) {
                                                "accuracy and the confusion matrix");
   app.add_option("--eval-frames", eval_frames, "Held-out frames per motion script")->check(CLI::Range(1, 10000));
   app.add_option("--eval-scenes", eval_scenes, "Held-out random-pose frames")->check(CLI::Range(0, 100000));
-  app.add_option("--stride", stride, "Classify one pixel per STRIDE x STRIDE block, per 320 px of width (--evaluate, --apply; default 2)")
+  app.add_option("--stride", stride, "Classify one pixel per STRIDE x STRIDE block, per 320 px of width (--evaluate, --apply)")
+      ->capture_default_str()
       ->check(CLI::Range(1, 16));
   app.add_option("--apply", apply_model, "Label depth PNGs (--input) with MODEL into colour PNGs in --output-dir");
   app.add_option("--input", inputs, "Depth PNGs for --apply (16-bit, raw units)");

@@ -94,6 +94,11 @@ class DepthInputBuilder {
 
  private:
   void median_filter(const DepthImage& depth);
+  void median_3x3(const DepthImage& depth);
+  // Sorts the column triples (a[u], b[u], c[u]) of three rows into lo[u] <= mid[u] <= hi[u].
+  static void sort_columns(const float* __restrict a, const float* __restrict b, const float* __restrict c, int n,
+                           float* __restrict lo, float* __restrict mid, float* __restrict hi);
+  void median_any(const DepthImage& depth);
   void segment(const std::optional<HandHint>& hint);
   void build_quadtree();
   // Share of a connected surface's outline where it goes on just beyond the far plane.
@@ -104,7 +109,12 @@ class DepthInputBuilder {
   DepthInput out_;
   std::vector<int> component_;
   std::vector<int> stack_;
-  std::vector<float> window_;
+  std::vector<int> selected_;        // the hand's pixel indices, in image order
+  std::vector<double> along_axis_;   // their 3D points' coordinate along the finger axis
+  std::vector<double> ray_u_;        // (u - c_x) / f_x per image column
+  std::vector<float> window_;              // median_any's window
+  std::vector<float> clean_;               // median_3x3's input, non-finite samples as 0
+  std::vector<float> lo_, mid_, hi_;       // median_3x3's sorted column triples
   std::vector<float> unclamped_mm_;  // median-filtered depth before the working volume
 };
 
