@@ -33,6 +33,8 @@ constexpr double kWristCutMarginMm = 10.0;
 // 0.18-0.24; a real hand straddling the far plane (SR305 231615/100: 0.25) is missed until it
 // comes nearer, which is what a working volume means.
 constexpr double kMaxFarPlaneCut = 0.15;
+// Quadtree leaves with room reserved up front (DepthInputBuilder's constructor).
+constexpr size_t kReservedLeaves = 2048;
 // Pixels this close to the image border mark the end of a blob where the arm leaves the image.
 constexpr int kBorderPx = 3;
 
@@ -94,7 +96,12 @@ int scaled_px(int px_at_320, int width) { return std::max(1, px_at_320 * std::ma
 
 }  // namespace
 
-DepthInputBuilder::DepthInputBuilder(DepthInputConfig config) : config_(config) {}
+DepthInputBuilder::DepthInputBuilder(DepthInputConfig config) : config_(config) {
+  // Steady state without allocation (the daemon's pipeline): a hand at arm's length makes 200-500
+  // quadtree leaves; storage grows only for more than kReservedLeaves (a hand very near the camera).
+  out_.gaussians.reserve(kReservedLeaves);
+  out_.mixture.reserve(kReservedLeaves);
+}
 
 const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::optional<HandHint>& hint,
                                            const PixelLabeller* labeller) {
@@ -223,39 +230,51 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
     wrist = hint->wrist_mm;
     found = true;
   }
-  // Keeps the pixels near `centre` and above the forearm cut, and lists them in selected_. The cut
-  // is the wrist plane, but never lower than one (generous) hand length below the farthest point
-  // along the axis: a wrist that drifted down the forearm must not let the forearm in, or the model
-  // follows it further down. Returns how many pixels it kept.
+  // Keeps the pixels near `centre` and above the forearm cut; sets hand_box_ (their bounding box)
+  // and hand_sum_ (the sum of their 3D points). The cut is the wrist plane, but never lower than
+  // one (generous) hand length below the farthest point along the axis: a wrist that drifted down
+  // the forearm must not let the forearm in, or the model follows it further down. Returns how many
+  // pixels it kept. Two passes over the image, no per-pixel lists: nothing grows with the hand.
   const auto select = [&]() {
     std::fill(out_.hand_mask.begin(), out_.hand_mask.end(), 0);
-    selected_.clear();
-    along_axis_.clear();
-    double tip = -std::numeric_limits<double>::infinity();
     // Unprojection by ray: p = (r_u d, r_v d, d) with r_u = (u - c_x) / f_x, r_v = (v - c_y) / f_y.
     ray_u_.resize(static_cast<size_t>(w));
     for (int u = 0; u < w; ++u) ray_u_[static_cast<size_t>(u)] = (u - cam.cx) / cam.fx;
+    const auto ray_point = [&](int u, int v, float depth) {
+      return Vector3d(ray_u_[static_cast<size_t>(u)] * depth, (v - cam.cy) / cam.fy * depth, depth);
+    };
+    PixelBox near{w, h, -1, -1};
+    double tip = -std::numeric_limits<double>::infinity();
     for (int v = 0; v < h; ++v) {
-      const double ray_v = (v - cam.cy) / cam.fy;
       const float* row = d.data() + static_cast<size_t>(v) * w;
       for (int u = 0; u < w; ++u) {
         if (row[u] <= 0.0F) continue;
-        const Vector3d p(ray_u_[static_cast<size_t>(u)] * row[u], ray_v * row[u], row[u]);
+        const Vector3d p = ray_point(u, v, row[u]);
         if ((p - centre).squaredNorm() > hand_radius * hand_radius) continue;
-        selected_.push_back(v * w + u);
-        along_axis_.push_back(p.dot(axis));
-        tip = std::max(tip, along_axis_.back());
+        out_.hand_mask[static_cast<size_t>(v) * w + u] = 1;
+        near.add(u, v);
+        tip = std::max(tip, p.dot(axis));
       }
     }
     const double cut = std::max(wrist.dot(axis) - kWristCutMarginMm, tip - kHandLengthMargin * config_.hand_length_mm);
-    size_t kept = 0;
-    for (size_t k = 0; k < selected_.size(); ++k) {
-      if (along_axis_[k] < cut) continue;
-      out_.hand_mask[static_cast<size_t>(selected_[k])] = 1;
-      selected_[kept++] = selected_[k];
+    hand_box_ = PixelBox{w, h, -1, -1};
+    hand_sum_ = Vector3d::Zero();
+    int kept = 0;
+    for (int v = near.v0; v <= near.v1; ++v) {
+      for (int u = near.u0; u <= near.u1; ++u) {
+        const auto i = static_cast<size_t>(v) * w + u;
+        if (!out_.hand_mask[i]) continue;
+        const Vector3d p = ray_point(u, v, d[i]);
+        if (p.dot(axis) < cut) {
+          out_.hand_mask[i] = 0;
+          continue;
+        }
+        hand_box_.add(u, v);
+        hand_sum_ += p;
+        ++kept;
+      }
     }
-    selected_.resize(kept);
-    return static_cast<int>(kept);
+    return kept;
   };
   const auto area_mm2 = [&](int pixels, double depth_mm) { return pixels * depth_mm * depth_mm / (cam.fx * cam.fy); };
 
@@ -386,9 +405,7 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
   out_.hand_pixels = count;
   out_.finger_axis = axis;
   out_.palm_centre_mm = centre;
-  Vector3d sum = Vector3d::Zero();
-  for (const int i : selected_) sum += point(static_cast<size_t>(i));
-  out_.hand_centroid_mm = count > 0 ? Vector3d(sum / count) : centre;
+  out_.hand_centroid_mm = count > 0 ? Vector3d(hand_sum_ / count) : centre;
   if (area_mm2(count, out_.hand_centroid_mm.z()) < config_.min_hand_area_mm2) {
     std::fill(out_.hand_mask.begin(), out_.hand_mask.end(), 0);
     out_.hand_pixels = 0;
@@ -427,24 +444,12 @@ void DepthInputBuilder::build_quadtree() {
   out_.gaussians.clear();
   if (out_.hand_pixels == 0) return;
   const int w = out_.camera.width;
-  const int h = out_.camera.height;
   const int root = scaled_px(config_.quadtree_root_px, w);
   const int min_leaf = scaled_px(config_.quadtree_min_leaf_px, w);
   // Only roots that touch the hand's bounding box.
-  int u0 = w;
-  int v0 = h;
-  int u1 = -1;
-  int v1 = -1;
-  for (const int i : selected_) {
-    const int u = i % w;
-    const int v = i / w;
-    u0 = std::min(u0, u);
-    v0 = std::min(v0, v);
-    u1 = std::max(u1, u);
-    v1 = std::max(v1, v);
-  }
-  for (int y = (v0 / root) * root; y <= v1; y += root) {
-    for (int x = (u0 / root) * root; x <= u1; x += root) quad(x, y, root, min_leaf);
+  const PixelBox& box = hand_box_;
+  for (int y = (box.v0 / root) * root; y <= box.v1; y += root) {
+    for (int x = (box.u0 / root) * root; x <= box.u1; x += root) quad(x, y, root, min_leaf);
   }
 }
 
@@ -515,6 +520,10 @@ double image_self_similarity(const std::vector<ImageGaussian>& gaussians) {
   // in one run |u_q - u_p| <= sqrt(2 S_max kPairCutoff).
   thread_local std::vector<double> us, vs, s2s;  // reused: no allocation once grown
   thread_local std::vector<size_t> order;
+  if (order.capacity() < kReservedLeaves) {
+    for (auto* column : {&us, &vs, &s2s}) column->reserve(kReservedLeaves);
+    order.reserve(kReservedLeaves);
+  }
   order.resize(gaussians.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return gaussians[a].u < gaussians[b].u; });

@@ -48,6 +48,19 @@ ImageMixtureSlice ImageMixture::Columns::slice(std::size_t begin, std::size_t en
   return {u.data() + i, v.data() + i, sigma2.data() + i, depth_mm.data() + i, static_cast<std::size_t>(hi - lo)};
 }
 
+void ImageMixture::Columns::reserve(std::size_t n) {
+  u.reserve(n);
+  v.reserve(n);
+  sigma2.reserve(n);
+  depth_mm.reserve(n);
+}
+
+void ImageMixture::reserve(std::size_t n) {
+  by_depth_.reserve(n);
+  by_label_.reserve(n);
+  order_.reserve(n);
+}
+
 void ImageMixture::assign(const std::vector<ImageGaussian>& gaussians) {
   const std::size_t n = gaussians.size();
   by_depth_.resize(n);

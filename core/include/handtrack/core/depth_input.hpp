@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -109,9 +110,19 @@ class DepthInputBuilder {
   DepthInput out_;
   std::vector<int> component_;
   std::vector<int> stack_;
-  std::vector<int> selected_;        // the hand's pixel indices, in image order
-  std::vector<double> along_axis_;   // their 3D points' coordinate along the finger axis
-  std::vector<double> ray_u_;        // (u - c_x) / f_x per image column
+  // Inclusive pixel bounding box; empty while u1 < u0.
+  struct PixelBox {
+    int u0, v0, u1, v1;
+    void add(int u, int v) {
+      u0 = std::min(u0, u);
+      v0 = std::min(v0, v);
+      u1 = std::max(u1, u);
+      v1 = std::max(v1, v);
+    }
+  };
+  PixelBox hand_box_{0, 0, -1, -1};                 // the segmented hand's pixels
+  Eigen::Vector3d hand_sum_ = Eigen::Vector3d::Zero();  // sum of their 3D points
+  std::vector<double> ray_u_;                       // (u - c_x) / f_x per image column
   std::vector<float> window_;              // median_any's window
   std::vector<float> clean_;               // median_3x3's input, non-finite samples as 0
   std::vector<float> lo_, mid_, hi_;       // median_3x3's sorted column triples

@@ -29,6 +29,8 @@ class ImageMixture {
   // Rebuilds the columns from the quadtree's Gaussians (labels >= 0). Storage is reused: no
   // allocation once a frame of this size has been seen.
   void assign(const std::vector<ImageGaussian>& gaussians);
+  // Room for n Gaussians, so that assign() of up to n allocates nothing.
+  void reserve(std::size_t n);
 
   [[nodiscard]] std::size_t size() const { return by_depth_.depth_mm.size(); }
   // The image Gaussians with lo_mm <= d_q <= hi_mm, any label.
@@ -40,6 +42,7 @@ class ImageMixture {
   struct Columns {
     std::vector<double> u, v, sigma2, depth_mm;
     void resize(std::size_t n);
+    void reserve(std::size_t n);
     void set(std::size_t i, const ImageGaussian& g);
     // [begin, end) narrowed to lo_mm <= d_q <= hi_mm (the range is ordered by depth).
     [[nodiscard]] ImageMixtureSlice slice(std::size_t begin, std::size_t end, double lo_mm, double hi_mm) const;
