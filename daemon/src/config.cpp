@@ -72,7 +72,7 @@ const std::vector<Field>& fields() {
     {"camera.height", IntRef{[](DaemonConfig& c) -> int& { return c.source_options.height; }}, 16, 4096,
      "preferred depth height", false},
     {"camera.fps", IntRef{[](DaemonConfig& c) -> int& { return c.source_options.fps; }}, 1, 1000,
-     "preferred depth frame rate", false},
+     "preferred depth frame rate (the synthetic camera runs at it)", false},
     // [synthetic]
     {"synthetic.frames", IntRef{[](DaemonConfig& c) -> int& { return c.source_options.synthetic_frames; }}, 2, 1000000,
      "frames in one pass of a synthetic motion (slow first half, fast second half)", false},

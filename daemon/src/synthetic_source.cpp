@@ -19,6 +19,7 @@ synth::SynthOptions synthetic_camera_options(const std::string& motion, const So
   o.noise = true;
   o.background = synth::Background::kBody;
   o.camera = synth::default_camera();
+  o.camera.fps = options.fps;
   return o;
 }
 
@@ -54,7 +55,6 @@ class SyntheticSource final : public DepthSource {
 
   GrabStatus grab(RawFrame& frame, std::chrono::milliseconds timeout) override {
     if (!pacer_.wait(timeout)) return GrabStatus::kTimeout;
-    frame.capture_ns = monotonic_ns();
     const auto frames = static_cast<uint64_t>(options_.synthetic_frames);
     // All motions: each plays one pass, then the next; one motion: back and forth for ever.
     auto& camera = cameras_.size() == 1 ? cameras_.front() : cameras_[(index_ / frames) % cameras_.size()];
@@ -70,6 +70,9 @@ class SyntheticSource final : public DepthSource {
                                ? static_cast<uint16_t>(std::clamp(std::lround(d * per_unit), 0L, 65535L))
                                : uint16_t{0};
     }
+    // Captured when the frame is complete, as a camera delivers it: rendering is the synthetic
+    // camera's exposure, not the tracker's latency.
+    frame.capture_ns = monotonic_ns();
     frame.frame_number = index_++;
     return GrabStatus::kFrame;
   }

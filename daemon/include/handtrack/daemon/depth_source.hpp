@@ -39,6 +39,7 @@ struct SourceOptions {
   bool loop = false;               // recordings: start again at the end
   bool as_fast_as_possible = false;  // recordings: no pacing at their own frame rate (--fast)
   // openni2: preferred depth mode (Sec. 7 used 320x240 at 60 fps); falls back to 640x480@30.
+  // synthetic: its frame rate (the motions keep their speed in seconds).
   int width = 320;
   int height = 240;
   int fps = 60;
