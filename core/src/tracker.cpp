@@ -52,6 +52,9 @@ void PoseTracker::reset() {
   previous_.reset();
   before_previous_.reset();
   low_confidence_run_ = 0;
+  confidence_level_ = 0.0;
+  check_next_ = false;
+  frames_since_check_ = 0;
 }
 
 void PoseTracker::override_pose(const PoseParams& pose) {
@@ -60,7 +63,7 @@ void PoseTracker::override_pose(const PoseParams& pose) {
 }
 
 std::optional<HandHint> PoseTracker::hint() const {
-  if (!previous_) return std::nullopt;
+  if (!previous_ || check_next_) return std::nullopt;
   // Only the global transform matters (no PosedHand: nothing is allocated on the hot path).
   const Vector3d t = previous_->segment<3>(kTranslationParam);
   const Eigen::Matrix3d camera_R_hand = rotation_exp(previous_->segment<3>(kRotationParam)) * frontal_rotation();
@@ -157,38 +160,14 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   };
   if (!input.has_hand()) return no_hand();
   EnergyFrame frame{&model_, &input, nullptr, nullptr};
-  // (Re)start: the open hand at the segmented hand, a few in-plane rotations, the best energy wins.
-  // The hypotheses are compared by confidence, not energy: E_sim has no notion of occlusion, so
-  // a wrong pose that pushes the big palm Gaussians onto the visible surface can out-score the right
-  // one (seen on fists), while it explains little of the hand's outline.
-  const auto start = [&]() {
-    OptimizerResult best{PoseParams::Zero(), -1e300};
-    double best_confidence = -1.0;
-    for (bool closed : kStartClosed) {
-      for (double offset : kStartRotations) {
-        const auto r = optimizer_.maximise(energy_, frame, initial_pose(input, offset, closed), scratch_,
-                                           config_.init_iterations);
-        scratch_.update(model_, r.params);
-        const double c = confidence(input, scratch_);
-        if (c > best_confidence + 1e-9 || (c > best_confidence - 1e-9 && r.energy > best.energy)) {
-          best = r;
-          best_confidence = c;
-        }
-      }
-    }
-    return best;
-  };
-
   OptimizerResult best{PoseParams::Zero(), -1e300};
   int winner = -1;
   bool guided_won = false;
-  // Late fusion needs part labels on the leaves; without them every particle is depth-only.
-  const bool labelled = std::any_of(input.gaussians.begin(), input.gaussians.end(),
-                                    [](const ImageGaussian& g) { return g.label != kBackground; });
-  const bool fuse = config_.mode == EnergyMode::kLateFusion && labelled;
+  const bool fuse = fuses(input);
   bool started = false;
+  CheckOutcome check = CheckOutcome::kNone;
   if (!previous_) {
-    best = start();
+    best = restart(input).result;
     started = true;
     recovering_ = true;
   } else {
@@ -214,6 +193,22 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
 
   scratch_.update(model_, best.params);
   double conf = confidence(input, scratch_);
+  if (check_next_ && previous_) {
+    // A suspected gross error: the tracked pose competes with the (re)start hypotheses on this
+    // freshly segmented frame; a (re)start replaces it only when it explains more of the hand, so
+    // a check cannot make good tracking worse by this measure.
+    const Fit fresh = restart(input);
+    check = fresh.confidence > conf ? CheckOutcome::kRestartWon : CheckOutcome::kTrackedKept;
+    if (check == CheckOutcome::kRestartWon) {
+      best = fresh.result;
+      conf = fresh.confidence;
+      winner = -1;
+      guided_won = false;
+      before_previous_.reset();  // no velocity from the wrong pose to the restart
+      previous_.reset();
+    }
+  }
+  watch_confidence(conf, check);
   low_confidence_run_ = conf < config_.lost_confidence ? low_confidence_run_ + 1 : 0;
   if (low_confidence_run_ >= config_.lost_frames && previous_) {
     // The fit is clearly wrong: forget the history, so the next frame is segmented without the
@@ -239,6 +234,56 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   out.winning_particle = winner;
   out.detection_guided_won = guided_won;
   return out;
+}
+
+PoseTracker::Fit PoseTracker::restart(const DepthInput& input) {
+  // The hypotheses are compared by confidence, not energy: E_sim has no notion of occlusion, so
+  // a wrong pose that pushes the big palm Gaussians onto the visible surface can out-score the right
+  // one (seen on fists), while it explains little of the hand's outline. No temporal prior: the
+  // history is what is in doubt. With late fusion the hypotheses optimise the detection-guided
+  // energy (Sec. 4.3): the part labels say where the palm and each finger are, which the open and
+  // closed hands do not know (docs/TRACKER.md "Recovery": 17 of 21 knocked-off trackers back
+  // within 30 frames with the depth-only energy, 21 with this one).
+  const EnergyFrame frame{&model_, &input, nullptr, nullptr};
+  const PoseEnergy& energy = fuses(input) ? guided_energy_ : energy_;
+  Fit best;
+  for (bool closed : kStartClosed) {
+    for (double offset : kStartRotations) {
+      const auto r = optimizer_.maximise(energy, frame, initial_pose(input, offset, closed), scratch_,
+                                         config_.init_iterations);
+      scratch_.update(model_, r.params);
+      const double c = confidence(input, scratch_);
+      if (c > best.confidence + 1e-9 || (c > best.confidence - 1e-9 && r.energy > best.result.energy)) {
+        best = Fit{r, c};
+      }
+    }
+  }
+  return best;
+}
+
+void PoseTracker::watch_confidence(double conf, CheckOutcome check) {
+  // A gross error shows as a sudden fall of the confidence (a knocked-off pose: 0.7-0.9 -> 0.15-0.5
+  // on the synthetic motions) that the lost rule (an absolute threshold) misses while the wrong
+  // pose still covers part of the hand. The level does not follow a suspect confidence down, so a
+  // (re)start that is better than the wrong pose but still poor is checked again; a check that
+  // keeps the tracked pose accepts its confidence as the level, so a pose that merely explains
+  // less (a hand turned sideways) is not checked again and again.
+  const bool first = confidence_level_ <= 0.0;
+  const bool suspect = !first && conf < config_.suspect_confidence_ratio * confidence_level_;
+  if (first || check == CheckOutcome::kTrackedKept) {
+    confidence_level_ = conf;
+  } else if (!suspect) {
+    confidence_level_ += config_.confidence_level_rate * (conf - confidence_level_);
+  }
+  frames_since_check_ = check == CheckOutcome::kNone ? frames_since_check_ + 1 : 0;
+  check_next_ = suspect && frames_since_check_ >= config_.check_interval_frames;
+}
+
+bool PoseTracker::fuses(const DepthInput& input) const {
+  // Late fusion needs part labels on the leaves; without them every particle is depth-only.
+  return config_.mode == EnergyMode::kLateFusion &&
+         std::any_of(input.gaussians.begin(), input.gaussians.end(),
+                     [](const ImageGaussian& g) { return g.label != kBackground; });
 }
 
 double PoseTracker::common_energy(const EnergyFrame& frame, const PoseParams& params) {

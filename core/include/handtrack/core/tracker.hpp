@@ -55,6 +55,15 @@ struct TrackerConfig {
   int init_iterations = 40;          // iterations for a (re)start from the open hand
   double lost_confidence = 0.3;      // below this for `lost_frames` frames in a row: restart
   int lost_frames = 3;
+  // Gross errors (issue 4; ours, the paper has no re-initialisation beyond Sec. 5's start): a
+  // confidence below `suspect_confidence_ratio` x its running level (an exponential average with
+  // rate `confidence_level_rate`) makes the next frame be segmented afresh and also fitted from the
+  // (re)start hypotheses; the tracked pose is replaced only by a (re)start that explains more of the
+  // hand. At most one such check per `check_interval_frames` frames. (Measured: docs/TRACKER.md,
+  // "Recovery".)
+  double suspect_confidence_ratio = 0.75;
+  double confidence_level_rate = 0.1;
+  int check_interval_frames = 5;
   // A (re)start must explain at least this much of the segmented surface, or there is no hand.
   double min_start_confidence = 0.6;
   uint64_t seed = 1;
@@ -79,8 +88,9 @@ class PoseTracker {
  public:
   explicit PoseTracker(TrackerConfig config = {});
 
-  // Where segmentation should look for the hand in the next frame: none before the first pose and
-  // after the fit was lost (the next frame is segmented afresh). Allocates nothing.
+  // Where segmentation should look for the hand in the next frame: none before the first pose,
+  // after the fit was lost, and before a check against a (re)start (the next frame is segmented
+  // afresh). Allocates nothing.
   [[nodiscard]] std::optional<HandHint> hint() const;
   // Optimises the pose for one frame's C_I and updates the history.
   TrackerOutput optimise(const DepthInput& input);
@@ -102,6 +112,19 @@ class PoseTracker {
 
  private:
   TrackerOutput describe(const PoseParams& params, double energy, TrackingState state);
+  // A pose and how much of the segmented hand it explains.
+  struct Fit {
+    OptimizerResult result{PoseParams::Zero(), -1e300};
+    double confidence = -1.0;
+  };
+  // Sec. 5's start: every (re)start hypothesis optimised on `input`, the best by confidence.
+  Fit restart(const DepthInput& input);
+  // After a frame's fit: tracks the running confidence level and decides whether the next frame
+  // checks the tracked pose against a (re)start.
+  enum class CheckOutcome { kNone, kTrackedKept, kRestartWon };
+  void watch_confidence(double confidence, CheckOutcome check);
+  // Late fusion with part labels on the leaves.
+  [[nodiscard]] bool fuses(const DepthInput& input) const;
 
   TrackerConfig config_;
   HandModel model_;
@@ -118,6 +141,9 @@ class PoseTracker {
   std::optional<PoseParams> before_previous_;
   int low_confidence_run_ = 0;
   bool recovering_ = false;
+  double confidence_level_ = 0.0;     // running level of the tracked pose's confidence
+  bool check_next_ = false;           // the next frame: fresh segmentation and a (re)start too
+  int frames_since_check_ = 0;
 };
 
 // preprocess + optimise on one thread: what handtrack-eval and the single-threaded path use.
