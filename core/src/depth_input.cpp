@@ -92,6 +92,16 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) double pair_run(cons
   return sum;
 }
 
+// Pixels checked at once when scanning for depth in the working volume (0 outside it).
+constexpr int kScanChunk = 16;
+
+// True when none of the kScanChunk depths from `d` is in the working volume: one vectorised max.
+bool nothing_in(const float* d) {
+  float m = 0.0F;
+  for (int k = 0; k < kScanChunk; ++k) m = std::max(m, d[k]);
+  return m <= 0.0F;
+}
+
 int scaled_px(int px_at_320, int width) { return std::max(1, px_at_320 * std::max(1, width / 320)); }
 
 }  // namespace
@@ -248,6 +258,10 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
     for (int v = 0; v < h; ++v) {
       const float* row = d.data() + static_cast<size_t>(v) * w;
       for (int u = 0; u < w; ++u) {
+        if (u % kScanChunk == 0 && u + kScanChunk <= w && nothing_in(row + u)) {
+          u += kScanChunk - 1;  // most of the image is outside the working volume
+          continue;
+        }
         if (row[u] <= 0.0F) continue;
         const Vector3d p = ray_point(u, v, row[u]);
         if ((p - centre).squaredNorm() > hand_radius * hand_radius) continue;
