@@ -459,46 +459,61 @@ void DepthInputBuilder::build_quadtree() {
   if (out_.hand_pixels == 0) return;
   const int w = out_.camera.width;
   const int root = scaled_px(config_.quadtree_root_px, w);
-  const int min_leaf = scaled_px(config_.quadtree_min_leaf_px, w);
-  // Only roots that touch the hand's bounding box.
+  // The smallest cell: the root halved while it is above the minimum leaf side (and even).
+  int cell = root;
+  while (cell > scaled_px(config_.quadtree_min_leaf_px, w) && cell % 2 == 0) cell /= 2;
+  // Count, sum, min and max of the hand's depths per smallest cell over the roots that touch the
+  // hand's bounding box, in one pass over the pixels; every quadtree node then aggregates cells
+  // instead of rescanning its pixels.
   const PixelBox& box = hand_box_;
-  for (int y = (box.v0 / root) * root; y <= box.v1; y += root) {
-    for (int x = (box.u0 / root) * root; x <= box.u1; x += root) quad(x, y, root, min_leaf);
+  cells_.x0 = (box.u0 / root) * root;
+  cells_.y0 = (box.v0 / root) * root;
+  cells_.side = cell;
+  cells_.columns = ((box.u1 / root + 1) * root - cells_.x0) / cell;
+  const int rows = ((box.v1 / root + 1) * root - cells_.y0) / cell;
+  // Room for a grid over the whole image once per resolution: no allocation in the steady state.
+  const auto whole_image = static_cast<size_t>((w / root + 1) * root / cell) *
+                           static_cast<size_t>((out_.camera.height / root + 1) * root / cell);
+  if (cells_.stats.capacity() < whole_image) cells_.stats.reserve(whole_image);
+  cells_.stats.assign(static_cast<size_t>(cells_.columns) * static_cast<size_t>(rows), CellStats{});
+  for (int v = box.v0; v <= box.v1; ++v) {
+    for (int u = box.u0; u <= box.u1; ++u) {
+      const auto i = static_cast<size_t>(v) * w + u;
+      if (!out_.hand_mask[i]) continue;
+      cells_.at((u - cells_.x0) / cell, (v - cells_.y0) / cell).add(out_.filtered_mm[i]);
+    }
+  }
+  for (int y = cells_.y0; y <= box.v1; y += root) {
+    for (int x = cells_.x0; x <= box.u1; x += root) quad(x, y, root);
   }
 }
 
-void DepthInputBuilder::quad(int x, int y, int side, int min_leaf) {
+void DepthInputBuilder::quad(int x, int y, int side) {
   const int w = out_.camera.width;
   const int h = out_.camera.height;
   const int xe = std::min(x + side, w);
   const int ye = std::min(y + side, h);
-  int count = 0;
-  float lo = std::numeric_limits<float>::infinity();
-  float hi = 0.0F;
-  double sum = 0.0;
-  for (int v = y; v < ye; ++v) {
-    for (int u = x; u < xe; ++u) {
-      const auto i = static_cast<size_t>(v) * w + u;
-      if (!out_.hand_mask[i]) continue;
-      const float dd = out_.filtered_mm[i];
-      ++count;
-      sum += dd;
-      lo = std::min(lo, dd);
-      hi = std::max(hi, dd);
-    }
+  CellStats node;
+  const int per_side = side / cells_.side;
+  const int cx = (x - cells_.x0) / cells_.side;
+  const int cy = (y - cells_.y0) / cells_.side;
+  for (int j = cy; j < cy + per_side; ++j) {
+    for (int i = cx; i < cx + per_side; ++i) node.merge(cells_.at(i, j));
   }
+  const int count = node.count;
   if (count == 0) return;
   const int area = (xe - x) * (ye - y);
   const bool full_enough = count >= config_.min_leaf_fill * area;
-  const bool flat = hi - lo < config_.quadtree_threshold_mm;
-  if (side > min_leaf && !(flat && full_enough)) {
+  const bool flat = node.hi - node.lo < config_.quadtree_threshold_mm;
+  if (side > cells_.side && !(flat && full_enough)) {
     const int half = side / 2;
-    quad(x, y, half, min_leaf);
-    quad(x + half, y, half, min_leaf);
-    quad(x, y + half, half, min_leaf);
-    quad(x + half, y + half, half, min_leaf);
+    quad(x, y, half);
+    quad(x + half, y, half);
+    quad(x, y + half, half);
+    quad(x + half, y + half, half);
     return;
   }
+  const double sum = node.sum;
   if (!full_enough) return;
   ImageGaussian g;
   g.u = x + 0.5 * side - 0.5;  // pixel centres are at integer coordinates

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -104,7 +105,7 @@ class DepthInputBuilder {
   void build_quadtree();
   // Share of a connected surface's outline where it goes on just beyond the far plane.
   [[nodiscard]] double far_plane_cut_fraction(int blob) const;
-  void quad(int x, int y, int side, int min_leaf);
+  void quad(int x, int y, int side);
 
   DepthInputConfig config_;
   DepthInput out_;
@@ -123,6 +124,32 @@ class DepthInputBuilder {
   PixelBox hand_box_{0, 0, -1, -1};                 // the segmented hand's pixels
   Eigen::Vector3d hand_sum_ = Eigen::Vector3d::Zero();  // sum of their 3D points
   std::vector<double> ray_u_;                       // (u - c_x) / f_x per image column
+  // The hand's depths per smallest quadtree cell (build_quadtree).
+  struct CellStats {
+    int count = 0;
+    float lo = std::numeric_limits<float>::infinity();
+    float hi = 0.0F;
+    double sum = 0.0;
+    void add(float d) {
+      ++count;
+      sum += d;
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
+    }
+    void merge(const CellStats& o) {
+      count += o.count;
+      sum += o.sum;
+      lo = std::min(lo, o.lo);
+      hi = std::max(hi, o.hi);
+    }
+  };
+  struct CellGrid {
+    int x0 = 0, y0 = 0;  // image pixel of cell (0, 0)
+    int side = 1;        // cell side, px
+    int columns = 0;
+    std::vector<CellStats> stats;
+    CellStats& at(int i, int j) { return stats[static_cast<size_t>(j) * static_cast<size_t>(columns) + static_cast<size_t>(i)]; }
+  } cells_;
   std::vector<float> window_;              // median_any's window
   std::vector<float> clean_;               // median_3x3's input, non-finite samples as 0
   std::vector<float> lo_, mid_, hi_;       // median_3x3's sorted column triples
