@@ -250,20 +250,22 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
     // Unprojection by ray: p = (r_u d, r_v d, d) with r_u = (u - c_x) / f_x, r_v = (v - c_y) / f_y.
     ray_u_.resize(static_cast<size_t>(w));
     for (int u = 0; u < w; ++u) ray_u_[static_cast<size_t>(u)] = (u - cam.cx) / cam.fx;
-    const auto ray_point = [&](int u, int v, float depth) {
-      return Vector3d(ray_u_[static_cast<size_t>(u)] * depth, (v - cam.cy) / cam.fy * depth, depth);
+    const auto ray_v = [&](int v) { return (v - cam.cy) / cam.fy; };
+    const auto ray_point = [&](int u, double r_v, float depth) {
+      return Vector3d(ray_u_[static_cast<size_t>(u)] * depth, r_v * depth, depth);
     };
     PixelBox near{w, h, -1, -1};
     double tip = -std::numeric_limits<double>::infinity();
     for (int v = 0; v < h; ++v) {
       const float* row = d.data() + static_cast<size_t>(v) * w;
+      const double r_v = ray_v(v);
       for (int u = 0; u < w; ++u) {
         if (u % kScanChunk == 0 && u + kScanChunk <= w && nothing_in(row + u)) {
           u += kScanChunk - 1;  // most of the image is outside the working volume
           continue;
         }
         if (row[u] <= 0.0F) continue;
-        const Vector3d p = ray_point(u, v, row[u]);
+        const Vector3d p = ray_point(u, r_v, row[u]);
         if ((p - centre).squaredNorm() > hand_radius * hand_radius) continue;
         out_.hand_mask[static_cast<size_t>(v) * w + u] = 1;
         near.add(u, v);
@@ -275,10 +277,11 @@ void DepthInputBuilder::segment(const std::optional<HandHint>& hint) {
     hand_sum_ = Vector3d::Zero();
     int kept = 0;
     for (int v = near.v0; v <= near.v1; ++v) {
+      const double r_v = ray_v(v);
       for (int u = near.u0; u <= near.u1; ++u) {
         const auto i = static_cast<size_t>(v) * w + u;
         if (!out_.hand_mask[i]) continue;
-        const Vector3d p = ray_point(u, v, d[i]);
+        const Vector3d p = ray_point(u, r_v, d[i]);
         if (p.dot(axis) < cut) {
           out_.hand_mask[i] = 0;
           continue;
@@ -474,7 +477,7 @@ void DepthInputBuilder::build_quadtree() {
   // Room for a grid over the whole image once per resolution: no allocation in the steady state.
   const auto whole_image = static_cast<size_t>((w / root + 1) * root / cell) *
                            static_cast<size_t>((out_.camera.height / root + 1) * root / cell);
-  if (cells_.stats.capacity() < whole_image) cells_.stats.reserve(whole_image);
+  cells_.stats.reserve(whole_image);
   cells_.stats.assign(static_cast<size_t>(cells_.columns) * static_cast<size_t>(rows), CellStats{});
   for (int v = box.v0; v <= box.v1; ++v) {
     for (int u = box.u0; u <= box.u1; ++u) {
@@ -513,13 +516,12 @@ void DepthInputBuilder::quad(int x, int y, int side) {
     quad(x + half, y + half, half);
     return;
   }
-  const double sum = node.sum;
   if (!full_enough) return;
   ImageGaussian g;
   g.u = x + 0.5 * side - 0.5;  // pixel centres are at integer coordinates
   g.v = y + 0.5 * side - 0.5;
   g.sigma_px = side / std::sqrt(2.0);  // Sec. 3.1: sigma = a / sqrt(2)
-  g.depth_mm = sum / count;
+  g.depth_mm = node.sum / count;
   g.side_px = side;
   const auto& labels = out_.pixel_labels;
   if (!labels.empty()) {
@@ -549,10 +551,8 @@ double image_self_similarity(const std::vector<ImageGaussian>& gaussians) {
   // in one run |u_q - u_p| <= sqrt(2 S_max kPairCutoff).
   thread_local std::vector<double> us, vs, s2s;  // reused: no allocation once grown
   thread_local std::vector<size_t> order;
-  if (order.capacity() < kReservedLeaves) {
-    for (auto* column : {&us, &vs, &s2s}) column->reserve(kReservedLeaves);
-    order.reserve(kReservedLeaves);
-  }
+  for (auto* column : {&us, &vs, &s2s}) column->reserve(kReservedLeaves);
+  order.reserve(kReservedLeaves);
   order.resize(gaussians.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return gaussians[a].u < gaussians[b].u; });
