@@ -77,10 +77,8 @@ struct SyntheticCamera::State {
   Motion motion;
   Raycaster raycaster;
   std::vector<ConeSphere> primitives;
-  // The static scene, drawn once into `background`; each frame starts from a copy of it and draws
-  // the hand (a z-buffer does not care about the order).
-  std::vector<PlanePatch> planes;
-  std::vector<ConeSphere> background_solids;
+  // The static scene, drawn once; each frame starts from a copy of it and draws the hand (a
+  // z-buffer does not care about the order).
   Raycaster background;
 
   State(SynthOptions o, const HandShape& s)
@@ -108,25 +106,27 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   }
   state_ = std::make_unique<State>(std::move(options), HandShape::for_subject(subject));
   State& s = *state_;
+  std::vector<PlanePatch> planes;
+  std::vector<ConeSphere> background_solids;
   switch (s.options.background) {
     case Background::kNone:
       break;
     case Background::kBody:
       // Torso: a 440 x 800 mm patch facing the camera, 700-850 mm away (beyond the tracker's
       // 150-600 mm working volume), slightly turned; neck and head above it.
-      s.planes.push_back(make_patch({30, 250, 780}, {0.15, -0.08, -1.0}, 220.0, 400.0));
-      s.background_solids.push_back(ConeSphere{{30, -150, 790}, {30, -200, 800}, 55.0, 55.0, kBackground});
-      s.background_solids.push_back(ConeSphere{{30, -270, 810}, {30, -270, 810}, 95.0, 95.0, kBackground});
+      planes.push_back(make_patch({30, 250, 780}, {0.15, -0.08, -1.0}, 220.0, 400.0));
+      background_solids.push_back(ConeSphere{{30, -150, 790}, {30, -200, 800}, 55.0, 55.0, kBackground});
+      background_solids.push_back(ConeSphere{{30, -270, 810}, {30, -270, 810}, 95.0, 95.0, kBackground});
       break;
     case Background::kTable:
       // A table top through (0, 250, 750) mm rising away from the camera (normal up and toward the
       // camera): at the bottom of the image ~610 mm, crossing the image centre at ~1 m.
-      s.planes.push_back(make_patch({0, 250, 750}, {0.0, -1.0, -0.5}, 0.0, 0.0));
+      planes.push_back(make_patch({0, 250, 750}, {0.0, -1.0, -0.5}, 0.0, 0.0));
       break;
   }
   s.background.clear();
-  for (const auto& p : s.background_solids) s.background.draw(p);
-  for (const auto& p : s.planes) s.background.draw(p);
+  for (const auto& p : background_solids) s.background.draw(p);
+  for (const auto& p : planes) s.background.draw(p);
 }
 
 SyntheticCamera::~SyntheticCamera() = default;
