@@ -240,11 +240,12 @@ double SmoothnessTerm::evaluate(const PoseParams& params, const PoseParams& prev
   return energy;
 }
 
-PoseEnergy::PoseEnergy(SimilarityFactor factor, const EnergyWeights& weights)
+PoseEnergy::PoseEnergy(SimilarityFactor factor, const EnergyWeights& weights, double label_share)
     : factor_(factor),
       weights_(weights),
       similarity_(factor == SimilarityFactor::kDepthAndLabel ? SimilarityFactor::kDepth : factor, weights.label_radius_mm),
       label_similarity_(SimilarityFactor::kLabel, weights.label_radius_mm),
+      label_share_(label_share),
       smoothness_(weights.smoothness_translation_per_mm) {}
 
 double PoseEnergy::evaluate(const EnergyFrame& frame, const PoseParams& params, PosedHand& hand,
@@ -262,9 +263,9 @@ double PoseEnergy::evaluate(const EnergyFrame& frame, const PoseParams& params, 
   e.similarity = similarity_.evaluate_centres(*frame.model, hand, *frame.input, want ? &g_sim : nullptr);
   if (factor_ == SimilarityFactor::kDepthAndLabel) {
     CentreGradients g_label = CentreGradients::Zero(3, n);
-    e.similarity = 0.5 * (e.similarity + label_similarity_.evaluate_centres(*frame.model, hand, *frame.input,
-                                                                            want ? &g_label : nullptr));
-    g_sim = 0.5 * (g_sim + g_label);
+    const double label = label_similarity_.evaluate_centres(*frame.model, hand, *frame.input, want ? &g_label : nullptr);
+    e.similarity = (1.0 - label_share_) * e.similarity + label_share_ * label;
+    g_sim = (1.0 - label_share_) * g_sim + label_share_ * g_label;
   }
   if (weights_.collision != 0.0) e.collision = collision_.evaluate_centres(*frame.model, hand, want ? &g_col : nullptr);
   if (weights_.limits != 0.0) e.limits = limits_.evaluate(*frame.model, params, want ? &g_lim : nullptr);

@@ -39,7 +39,7 @@ PoseTracker::PoseTracker(TrackerConfig config)
       model_(HandModel::default_adult(config.scale)),
       energy_(SimilarityFactor::kDepth, config.weights),
       guided_energy_(SimilarityFactor::kDepthAndLabel, config.weights),
-      label_energy_(SimilarityFactor::kLabel, config.weights),
+      common_energy_(SimilarityFactor::kDepthAndLabel, config.weights, config.fusion_label_weight),
       optimizer_(config.optimizer),
       rng_(config.seed) {}
 
@@ -182,7 +182,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
       auto r = optimizer_.maximise(guided ? guided_energy_ : energy_, frame, particle, scratch_);
       // Late fusion (Sec. 5): "the pose particle which converges with the best energy value is
       // chosen". The particles optimise different energies, so each is judged by one common energy.
-      if (fuse) r.energy = common_energy(frame, r.params);
+      if (fuse) r.energy = common_energy_.evaluate(frame, r.params, scratch_, nullptr);
       if (r.energy > best.energy) {
         best = r;
         winner = i;
@@ -284,13 +284,6 @@ bool PoseTracker::fuses(const DepthInput& input) const {
   return config_.mode == EnergyMode::kLateFusion &&
          std::any_of(input.gaussians.begin(), input.gaussians.end(),
                      [](const ImageGaussian& g) { return g.label != kBackground; });
-}
-
-double PoseTracker::common_energy(const EnergyFrame& frame, const PoseParams& params) {
-  // E_col, E_lim and E_smo are the same in both energies, so the blend only mixes the two E_sim.
-  const double lambda = config_.fusion_label_weight;
-  return (1.0 - lambda) * energy_.evaluate(frame, params, scratch_, nullptr) +
-         lambda * label_energy_.evaluate(frame, params, scratch_, nullptr);
 }
 
 TrackerOutput PoseTracker::describe(const PoseParams& params, double energy,

@@ -32,7 +32,8 @@ enum class SimilarityFactor {
   kDepth,  // Delta(p,q) = max(0, 1 - |d_p - d_q| / (2 sigma_h))                        (eq. 7)
   kLabel,  // Delta_l(p,q) = [l_p = l_q] max(0, 1 - |d_p - d_q| / (2 R_i))            (Sec. 4.3)
   // The detection-guided energy read as "an augmented version of the depth-only energy" (Sec. 1):
-  // E_sim = 0.5 (E_sim[Delta] + E_sim[Delta_l]); the mean keeps E_sim on the scale of eq. 2, so
+  // E_sim = (1 - s) E_sim[Delta] + s E_sim[Delta_l] with the label share s (PoseEnergy's
+  // constructor; 0.5 for the guided energy); a weighted mean keeps E_sim on the scale of eq. 2, so
   // w_c, w_l and w_s keep their balance. PoseEnergy sums two SimilarityTerms for it.
   kDepthAndLabel,
 };
@@ -110,7 +111,8 @@ struct EnergyFrame {
 
 class PoseEnergy {
  public:
-  PoseEnergy(SimilarityFactor factor, const EnergyWeights& weights);
+  // `label_share`: s of SimilarityFactor::kDepthAndLabel (unused by the other factors).
+  PoseEnergy(SimilarityFactor factor, const EnergyWeights& weights, double label_share = 0.5);
 
   // E(Theta) (eq. 2); adds dE/dTheta into *gradient (which it zeroes first) when not null.
   // `hand` is scratch space for the posed model.
@@ -123,7 +125,8 @@ class PoseEnergy {
   SimilarityFactor factor_;
   EnergyWeights weights_;
   SimilarityTerm similarity_;
-  SimilarityTerm label_similarity_;  // kDepthAndLabel only: the second half of E_sim
+  SimilarityTerm label_similarity_;  // kDepthAndLabel only: the label part of E_sim
+  double label_share_;
   CollisionTerm collision_;
   JointLimitTerm limits_;
   SmoothnessTerm smoothness_;

@@ -129,11 +129,10 @@ class PoseTracker {
   TrackerConfig config_;
   HandModel model_;
   // Late fusion: the particles' common energy at `params` (see EnergyMode).
-  double common_energy(const EnergyFrame& frame, const PoseParams& params);
 
   PoseEnergy energy_;            // depth-only (Sec. 4.1)
   PoseEnergy guided_energy_;     // detection-guided (Sec. 4.3), augmented: depth and label factors
-  PoseEnergy label_energy_;      // label factor only: its E_sim is the label part of the common energy
+  PoseEnergy common_energy_;     // late fusion: compares the particles (label share fusion_label_weight)
   AdaptiveGradientAscent optimizer_;
   PosedHand scratch_;
   std::mt19937_64 rng_;
