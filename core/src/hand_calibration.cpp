@@ -179,8 +179,8 @@ double surface_agreement(const HandModel& model, const PosedHand& hand, const De
   return hand_pixels > 0 ? 1.0 - mismatch / hand_pixels : 0.0;
 }
 
-}  // namespace
-
+// One grid point: re-fits each frame's pose for `scale` (`iterations` of eq. 2 from `poses`,
+// updated in place) and returns the mean surface agreement over the frames.
 double fit_and_score(const std::vector<CalibrationFrame>& frames, const TrackerConfig& tracker, const HandScale& scale,
                      int iterations, std::vector<PoseParams>& poses) {
   const PoseEnergy energy(SimilarityFactor::kDepth, tracker.weights);
@@ -198,13 +198,15 @@ double fit_and_score(const std::vector<CalibrationFrame>& frames, const TrackerC
   return total / static_cast<double>(frames.size());
 }
 
+}  // namespace
+
 CalibrationResult calibrate_hand_scale(const std::vector<CalibrationFrame>& frames, const TrackerConfig& tracker,
                                        const CalibrationConfig& config) {
   check_grid(frames, config);
   // The score of a grid point: the mean surface agreement less the prior on sigma / width.
-  const auto fit_and_score = [&](const HandScale& scale, std::vector<PoseParams>& poses) {
+  const auto score_of = [&](const HandScale& scale, std::vector<PoseParams>& poses) {
     const double log_ratio = std::log(scale.sigma / scale.width);
-    return handtrack::fit_and_score(frames, tracker, scale, config.iterations, poses) -
+    return fit_and_score(frames, tracker, scale, config.iterations, poses) -
            kSigmaWidthPrior * log_ratio * log_ratio;
   };
 
@@ -212,7 +214,7 @@ CalibrationResult calibrate_hand_scale(const std::vector<CalibrationFrame>& fram
   result.scale = tracker.scale;
   std::vector<PoseParams> best_poses;
   for (const auto& f : frames) best_poses.push_back(f.pose);
-  result.score = fit_and_score(result.scale, best_poses);
+  result.score = score_of(result.scale, best_poses);
   result.evaluations = 1;
 
   // One greedy line search: from the current best value outward, up to `reach` steps (within
@@ -232,7 +234,7 @@ CalibrationResult calibrate_hand_scale(const std::vector<CalibrationFrame>& fram
       for (int k = 1; k <= (direction > 0 ? up : down); ++k) {
         trial.*member = start + direction * k * config.step;
         if (member == &HandScale::width) trial.sigma = result.scale.sigma * trial.width / start;
-        const double s = fit_and_score(trial, poses);
+        const double s = score_of(trial, poses);
         ++best.evaluations;
         if (s > best.score) {
           best.score = s;

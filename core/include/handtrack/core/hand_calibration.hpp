@@ -5,7 +5,8 @@
 // we evaluate the energy function value from Equation 2. The parameters that obtain the best energy
 // are selected."
 //
-// Greedy: one scale parameter at a time (length, then width, then sigma), the others held, over
+// Greedy: one scale parameter at a time (length, then width, then sigma), the others held (sigma
+// follows width in width's search, see below), over
 // the grid lo, lo + step, .., hi; then a second pass of each within a few steps of the value found.
 // At each grid point the model is rebuilt and the pose of every calibration frame re-fitted with
 // eq. 2 (a few iterations, warm-started from the pose fitted at the neighbouring grid point, so the
@@ -57,11 +58,6 @@ struct CalibrationResult {
 // bad grid.
 CalibrationResult calibrate_hand_scale(const std::vector<CalibrationFrame>& frames, const TrackerConfig& tracker,
                                        const CalibrationConfig& config = {});
-
-// One grid point: re-fits each frame's pose for `scale` (`iterations` of eq. 2 from `poses`,
-// updated in place) and returns the mean score over the frames.
-double fit_and_score(const std::vector<CalibrationFrame>& frames, const TrackerConfig& tracker, const HandScale& scale,
-                     int iterations, std::vector<PoseParams>& poses);
 
 // The frames a calibration uses: C_I and the tracked pose of frames that were tracked well
 // (confidence >= min_confidence), at most one every `stride` frames, at most `max_frames`.
