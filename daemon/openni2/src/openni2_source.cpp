@@ -441,18 +441,6 @@ class OniRecording final : public OpenNi2SourceBase {
       return false;
     }
     if (!open_depth_stream(why)) return false;
-    frame_count_ = std::max(0, device_->getPlaybackControl()->getNumberOfFrames(*stream_));
-    // Without repeat, OniFile's player thread spins at the end of the file over its list of
-    // streams, unlocked, and destroying our stream then crashes it (close() after a recording
-    // played to its end: 3 crashes in 40 reopen tests on a busy machine). With repeat it rewinds
-    // and waits for the next read instead, so repeat stays on whenever the frame count tells the
-    // end (grab() ends after frame_count_ frames); only a recording of unknown length plays
-    // without repeat, ending on silence.
-    if (frame_count_ > 0 && !options_.loop &&
-        device_->getPlaybackControl()->setRepeatEnabled(true) != openni::STATUS_OK) {
-      *why = with_detail("cannot set playback repeat");
-      return false;
-    }
     last_frame_ns_ = openni2::monotonic_ns();
     logger()->info("{}: {} depth frames {}x{} at {} fps, f {:.1f}/{:.1f} px, depth unit {} mm{}{}", describe(),
                    frame_count_, camera_.width, camera_.height, camera_.fps, camera_.fx, camera_.fy,
@@ -461,9 +449,15 @@ class OniRecording final : public OpenNi2SourceBase {
     return true;
   }
 
-  // Playback set before the stream starts: repeat per options.loop; speed -1 ("manual": OpenNI2
-  // hands out the next frame when the reader waits for it, so none is dropped) when as fast as
-  // possible, else 1.0 (the recording's own frame rate).
+  // Playback set before the stream starts: speed -1 ("manual": OpenNI2 hands out the next frame
+  // when the reader waits for it, so none is dropped) when as fast as possible, else 1.0 (the
+  // recording's own frame rate); repeat when looping, and also in manual playback of a recording
+  // whose frame count is known. Without repeat, OniFile's player thread spins at the end of the
+  // file over its list of streams, unlocked, and destroying our stream then crashes it (close()
+  // after a manual playback to the end: 3 crashes in 40 reopen tests on a busy machine). With
+  // repeat it rewinds and waits for the next read instead, and grab() still ends after
+  // frame_count_ frames. At the recording's own rate repeat is no cure: the rewound frame 1 follows
+  // the last frame at once and can replace it before it is read.
   bool configure(std::string* why) override {
     openni::PlaybackControl* playback = device_->getPlaybackControl();
     const float speed = options_.as_fast_as_possible ? -1.0F : 1.0F;
@@ -471,7 +465,9 @@ class OniRecording final : public OpenNi2SourceBase {
       *why = with_detail("cannot set the playback speed");
       return false;
     }
-    if (playback->setRepeatEnabled(options_.loop) != openni::STATUS_OK) {
+    frame_count_ = std::max(0, playback->getNumberOfFrames(*stream_));
+    const bool repeat = options_.loop || (options_.as_fast_as_possible && frame_count_ > 0);
+    if (playback->setRepeatEnabled(repeat) != openni::STATUS_OK) {
       *why = with_detail("cannot set playback repeat");
       return false;
     }
