@@ -1,0 +1,70 @@
+#include "preprocess_stage.hpp"
+
+#include "clock.hpp"
+#include "logging.hpp"
+
+#include <algorithm>
+
+namespace handtrack::daemon {
+
+PreprocessStage::PreprocessStage(const TrackerConfig& config, TrackerReload& reload, const HintMailbox& hint,
+                                 const PartForest* forest, PipelineTally& tally, StageWatch& watch)
+    : reload_(reload), hint_(hint), forest_(forest), tally_(tally), watch_(watch), input_config_(config.input) {}
+
+void PreprocessStage::apply_reload() {
+  if (const auto g = reload_.generation(); g != input_generation_) {
+    input_config_ = reload_.config().input;
+    input_generation_ = g;
+  }
+}
+
+void PreprocessStage::step(Frame& f) {
+  f.preprocess_start_ns = monotonic_ns();
+  watch_.busy(Stage::kPreprocess, f.seq, f.preprocess_start_ns);
+  apply_reload();
+  if (f.builder_generation != input_generation_) {
+    f.builder = DepthInputBuilder(input_config_);  // SIGHUP only: allocates
+    f.builder_generation = input_generation_;
+  }
+  f.input = nullptr;
+  f.empty = false;
+  f.malformed = false;
+  f.resolution_changed = false;
+  const CameraIntrinsics& cam = f.raw.camera;
+  const auto n = static_cast<size_t>(std::max(cam.width, 0)) * static_cast<size_t>(std::max(cam.height, 0));
+  if (n == 0 || f.raw.depth_raw.size() != n || !(cam.depth_scale_mm > 0.0)) {
+    f.malformed = true;
+  } else {
+    if (cam.width != stream_width_ || cam.height != stream_height_) {
+      if (stream_width_ != 0) {
+        tally_.resolution_changes.fetch_add(1, std::memory_order_relaxed);
+        log().info("resolution changed from {}x{} to {}x{} at frame {}: frame buffers rebuilt, tracking restarts",
+                   stream_width_, stream_height_, cam.width, cam.height, f.seq);
+        f.resolution_changed = true;
+      }
+      stream_width_ = cam.width;
+      stream_height_ = cam.height;
+    }
+    // Raw units to mm; count pixels inside the working volume (Sec. 4: 150..600 mm).
+    f.depth.camera = cam;
+    f.depth.depth_mm.resize(n);  // no reallocation once a resolution has been seen
+    const auto scale = static_cast<float>(cam.depth_scale_mm);
+    const auto near = static_cast<float>(input_config_.near_mm);
+    const auto far = static_cast<float>(input_config_.far_mm);
+    size_t in_volume = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const float d = static_cast<float>(f.raw.depth_raw[i]) * scale;
+      f.depth.depth_mm[i] = d;
+      in_volume += (d >= near && d <= far) ? 1 : 0;
+    }
+    if (in_volume == 0) {
+      f.empty = true;
+    } else {
+      f.input = &f.builder.build(f.depth, hint_.get(), forest_);
+    }
+  }
+  f.preprocess_end_ns = monotonic_ns();
+  watch_.idle(Stage::kPreprocess);
+}
+
+}  // namespace handtrack::daemon

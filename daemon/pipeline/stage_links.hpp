@@ -1,0 +1,63 @@
+#pragma once
+// What flows between stages besides frames: the segmentation hint (optimize -> preprocess) and a
+// reloaded tracker configuration (control thread -> preprocess and optimize).
+//
+// Thread roles: @thread-safe (a mutex each; taken once per frame, never contended for long).
+#include "handtrack/core/tracker.hpp"
+
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <optional>
+
+namespace handtrack::daemon {
+
+// The hint for segmentation from the last optimized pose: optimize writes after every frame,
+// preprocess reads before every frame. A frame preprocessed while the previous one is still being
+// optimized uses the hint of the one before: that lag of one frame is the price of the overlap.
+class HintMailbox {
+ public:
+  void put(const std::optional<HandHint>& hint) {
+    std::lock_guard lock(mutex_);
+    hint_ = hint;
+  }
+  [[nodiscard]] std::optional<HandHint> get() const {
+    std::lock_guard lock(mutex_);
+    return hint_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::optional<HandHint> hint_;
+};
+
+// SIGHUP: the control thread posts a new tracker configuration; each stage that depends on it
+// compares the generation it last applied with generation() between two frames and takes the
+// new configuration when they differ.
+class TrackerReload {
+ public:
+  explicit TrackerReload(const TrackerConfig& initial) : config_(initial) {}
+
+  void post(const TrackerConfig& config) {
+    {
+      std::lock_guard lock(mutex_);
+      config_ = config;
+    }
+    // SYNC: release, pairs with generation()'s acquire: a stage that sees the new generation
+    // takes the mutex after it and so reads the new configuration (the mutex alone orders the
+    // configuration; the counter only saves the lock on the 99.99 % of frames without a reload).
+    generation_.fetch_add(1, std::memory_order_acq_rel);
+  }
+  [[nodiscard]] uint64_t generation() const { return generation_.load(std::memory_order_acquire); }
+  [[nodiscard]] TrackerConfig config() const {
+    std::lock_guard lock(mutex_);
+    return config_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  TrackerConfig config_;
+  std::atomic<uint64_t> generation_{0};
+};
+
+}  // namespace handtrack::daemon
