@@ -3,6 +3,7 @@
 #include "handtrack/core/hand_model.hpp"
 
 #include "fast_exp.hpp"
+#include "target_clones.hpp"
 
 #include <Eigen/Eigenvalues>
 
@@ -76,7 +77,7 @@ constexpr double kPairCutoff = 25.0;
 // reach: one run of E(C_I,C_I). The hand's leaves lie close together (a third of all pairs are in
 // reach, in no predictable order), so the run is branch-free and vectorised like E_sim's pair sums
 // (energy.cpp): 2 doubles per SSE2 register, 4 with FMA in the x86-64-v3 clone.
-__attribute__((target_clones("arch=x86-64-v3", "default"))) double pair_run(const double* us, const double* vs,
+HANDTRACK_TARGET_CLONES double pair_run(const double* us, const double* vs,
                                                                             const double* s2s, size_t n, double u,
                                                                             double v, double s2) {
   double sum = 0.0;

@@ -1,6 +1,7 @@
 #include "handtrack/core/energy.hpp"
 
 #include "fast_exp.hpp"
+#include "target_clones.hpp"
 
 #include <algorithm>
 #include <array>
@@ -42,7 +43,7 @@ struct PairSums {
 
 // Branch-free so that gcc vectorises it: 2 doubles per SSE2 register on any x86-64, 4 with fused
 // multiply-adds in the x86-64-v3 (AVX2, FMA) clone, which the loader picks on CPUs that have it.
-__attribute__((target_clones("arch=x86-64-v3", "default"))) PairSums pair_sums(const ProjectedGaussian& p,
+HANDTRACK_TARGET_CLONES PairSums pair_sums(const ProjectedGaussian& p,
                                                                                const ImageMixtureSlice& q) {
   // Everything the loop reads in locals: gcc then sees unit-stride loads, not gathers.
   const double* const q_u = q.u;
@@ -91,7 +92,7 @@ constexpr size_t kCollisionChunk = 128;
 // D_ab = (2 pi)^(3/2) (s_a^2 s_b^2 / S)^(3/2) exp(-|mu_a - mu_b|^2 / 2S) of each pair (eq. 8),
 // with the Gaussians' centres and sigma^2 as arrays; stores D_ab / S per pair and returns sum D_ab.
 // Pairs further apart than exp(-30) ~ 1e-13 count 0.
-__attribute__((target_clones("arch=x86-64-v3", "default"))) double collision_overlaps(
+HANDTRACK_TARGET_CLONES double collision_overlaps(
     const CollisionPair* pairs, size_t count, const double* x, const double* y, const double* z,
     const double* sigma2, double* d_over_s) {
   constexpr double kMaxExponent = 30.0;
