@@ -82,6 +82,7 @@ GrabStage::Step GrabStage::step(Frame& f) {
       f.seq = next_seq_++;
       f.capture_ns = f.raw.capture_ns != 0 ? f.raw.capture_ns : now;
       f.grab_end_ns = now;
+      // SYNC: acq_rel, decides finished() with `completed` (pipeline_tally.hpp).
       if (tally_.captured.fetch_add(1, std::memory_order_acq_rel) == 0) {
         tally_.first_capture_ns.store(f.capture_ns, std::memory_order_relaxed);
       }

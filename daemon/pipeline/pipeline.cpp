@@ -70,6 +70,7 @@ struct Pipeline::Impl {
   // SYNC: relaxed; it only selects finished()'s answer and the exit code, read after stop_flag.
   std::atomic<bool> failed_flag{false};
 
+  // SYNC: acquire, pairs with the release stores in stop() and run_stage().
   bool stopping() const { return stop_flag.load(std::memory_order_acquire); }
   void wake_all() {
     for (auto* b : {&grab_bell, &pre_bell, &opt_bell, &pub_bell}) b->ring();
@@ -85,7 +86,7 @@ struct Pipeline::Impl {
     } catch (const std::exception& e) {
       log().error("{} thread failed: {}", name, e.what());
       failed_flag.store(true, std::memory_order_relaxed);
-      stop_flag.store(true, std::memory_order_release);
+      stop_flag.store(true, std::memory_order_release);  // SYNC: release, pairs with stopping()
       wake_all();
     }
   }
@@ -150,6 +151,8 @@ struct Pipeline::Impl {
         grab_bell.wait(ticket, kIdleWaitNs);
       }
     }
+    // SYNC: release, pairs with the acquire loads in finished() and the recorder's done(): every
+    // capture this thread counted happened before.
     grab_done.store(true, std::memory_order_release);
     wake_all();
   }
@@ -227,6 +230,8 @@ struct Pipeline::Impl {
       }
       stats.maybe_publish(monotonic_ns());
     }
+    // SYNC: release, pairs with the acquire loads in finished() and the recorder's done(): every
+    // capture this thread counted happened before.
     grab_done.store(true, std::memory_order_release);
   }
 
@@ -292,6 +297,7 @@ bool Pipeline::start(std::string* why) {
     m.threads.emplace_back([&m] {
       pthread_setname_np(pthread_self(), "ht-record");
       m.run_stage("record", [&m] {
+        // SYNC: acquire, pairs with the grab thread's release store: the last offer() is queued.
         m.recorder->run([&m] { return m.stopping() || m.grab_done.load(std::memory_order_acquire); });
       });
     });
@@ -308,7 +314,7 @@ bool Pipeline::start(std::string* why) {
 }
 
 void Pipeline::stop() {
-  impl_->stop_flag.store(true, std::memory_order_release);
+  impl_->stop_flag.store(true, std::memory_order_release);  // SYNC: release, pairs with stopping()
   impl_->wake_all();
 }
 
@@ -323,6 +329,8 @@ void Pipeline::join() {
 bool Pipeline::finished() const {
   const Impl& m = *impl_;
   if (m.failed_flag.load(std::memory_order_relaxed)) return true;
+  // SYNC: acquire loads, pairing with grab_done's release store and the acq_rel increments of
+  // `captured` and `completed` (pipeline_tally.hpp): `captured` read here is final.
   if (!m.grab_done.load(std::memory_order_acquire)) return false;
   return m.tally.completed.load(std::memory_order_acquire) >= m.tally.captured.load(std::memory_order_acquire);
 }

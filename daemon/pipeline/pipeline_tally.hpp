@@ -37,6 +37,7 @@ struct PipelineTally {
     dropped.fetch_add(n, std::memory_order_relaxed);
     complete(n);
   }
+  // SYNC: acq_rel, see the top of this file.
   void complete(uint64_t n = 1) { completed.fetch_add(n, std::memory_order_acq_rel); }
 
   // Everything but last_stats (kept by IntervalStats).

@@ -48,6 +48,7 @@ class TrackerReload {
     // configuration; the counter only saves the lock on the 99.99 % of frames without a reload).
     generation_.fetch_add(1, std::memory_order_acq_rel);
   }
+  // SYNC: acquire, pairs with post()'s increment.
   [[nodiscard]] uint64_t generation() const { return generation_.load(std::memory_order_acquire); }
   [[nodiscard]] TrackerConfig config() const {
     std::lock_guard lock(mutex_);
