@@ -4,7 +4,7 @@
 // then ring()s; the consumer takes a ticket, tries to pop, and waits on the ticket only if the
 // queue was empty.
 //
-// Thread roles: any number of threads ring(); any number wait(). @thread-safe
+// Thread roles: thread-safe; any number of threads ring(), any number wait().
 #include <atomic>
 #include <climits>
 #include <cstdint>

@@ -4,7 +4,7 @@
 // segmentation. A frame with no hand, or the first of a new resolution, restarts the tracker.
 // A reloaded configuration (SIGHUP) rebuilds the tracker between two frames.
 //
-// Thread roles: step() from the optimize thread (or the single thread) only.
+// Thread roles: thread-bound: step() from the optimize thread (or the single thread).
 #include "frame.hpp"
 #include "stage_links.hpp"
 #include "stage_watch.hpp"

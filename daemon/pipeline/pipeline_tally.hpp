@@ -2,7 +2,7 @@
 // PipelineTally: the pipeline's counters, written by the stages, read by the control thread
 // (Pipeline::counters(), finished()).
 //
-// Thread roles: each counter has one writing stage (noted), any thread reads. @thread-safe
+// Thread roles: thread-safe; each counter has one writing stage (noted), any thread reads.
 //
 // SYNC: plain counters are relaxed: they are statistics, read for logs and STATUS=, and carry no
 // other data. The exceptions are `captured` and `completed`, which decide Pipeline::finished():

@@ -6,7 +6,7 @@
 // the working volume are marked empty (published as no_hand). The first frame of a new resolution
 // is marked so that the optimizer restarts.
 //
-// Thread roles: step() from the preprocess thread (or the single thread) only.
+// Thread roles: thread-bound: step() from the preprocess thread (or the single thread).
 #include "frame.hpp"
 #include "pipeline_tally.hpp"
 #include "stage_links.hpp"

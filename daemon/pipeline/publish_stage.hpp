@@ -3,7 +3,7 @@
 // frame, stamped with its stage timings), counts skipped and empty frames, feeds the interval
 // statistics, and logs tracking-state changes at most once a second.
 //
-// Thread roles: step() from the publish thread (or the single thread) only.
+// Thread roles: thread-bound: step() from the publish thread (or the single thread).
 #include "frame.hpp"
 #include "interval_stats.hpp"
 #include "pipeline_tally.hpp"

@@ -2,7 +2,7 @@
 // What flows between stages besides frames: the segmentation hint (optimize -> preprocess) and a
 // reloaded tracker configuration (control thread -> preprocess and optimize).
 //
-// Thread roles: @thread-safe (a mutex each; taken once per frame, never contended for long).
+// Thread roles: thread-safe (a mutex each; taken once per frame, never contended for long).
 #include "handtrack/core/tracker.hpp"
 
 #include <atomic>

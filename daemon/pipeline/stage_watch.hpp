@@ -4,7 +4,7 @@
 // the control thread asks whether any stage has been busy on one frame for too long.
 //
 // Thread roles: busy()/idle() of stage S from S's thread only; stalled()/describe() from any
-// thread. @thread-safe
+// thread. Thread-safe.
 #include "handtrack/daemon/config.hpp"
 
 #include <array>

@@ -2,7 +2,7 @@
 // Throttle: at most one warning a second for a condition that can repeat every frame (STYLE.md:
 // never log per frame in steady state).
 //
-// Thread roles: @thread-confined (one stage's thread).
+// Thread roles: thread-bound (one stage's thread).
 #include <cstdint>
 
 namespace handtrack::daemon {

@@ -19,8 +19,8 @@
  * HANDTRACK_NO_RECORD) and negative errors. No function throws, allocates after handtrack_open, or
  * blocks longer than its timeout.
  *
- * Thread safety: one handtrack_client belongs to one thread at a time; distinct clients are
- * independent. handtrack_strerror and handtrack_abi_version may be called from any thread.
+ * Thread roles: reentrant: one handtrack_client belongs to one thread at a time; distinct clients are
+ * independent. handtrack_strerror and handtrack_abi_version are thread-safe.
  *
  * ABI: the record and header layouts are fixed for a given HANDTRACK_ABI_VERSION; a client refuses
  * a segment whose magic, ABI version, record size or layout differ (see docs/IPC.md).

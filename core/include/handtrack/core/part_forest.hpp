@@ -36,7 +36,7 @@
 //     end-8    8  u64 FNV-1a 64 of every byte before it
 //
 // Only the nodes that exist are stored (the paper's full trees took 1 GB).
-// @thread A loaded PartForest is immutable: label() may be called from several threads at once.
+// Thread roles: thread-safe once loaded (immutable): label() may run on several threads at once.
 
 #include "handtrack/core/depth_input.hpp"
 #include "handtrack/core/hand_layout.hpp"
