@@ -7,7 +7,7 @@
 // double); a non-finite value is printed as null (JSON has no NaN).
 #include <handtrack/client.hpp>
 
-#include <CLI/CLI.hpp>
+#include "handtrack/common/cli.hpp"
 
 #include <charconv>
 #include <chrono>
@@ -119,10 +119,7 @@ void format_status(const handtrack_writer_status& s, Line& out) {
   out.key("source_errors"), out.number(s.stats.source_errors), out.raw("}}\n");
 }
 
-int fail(const std::string& message) {
-  std::fprintf(stderr, "handtrack-cat: %s\n", message.c_str());
-  return 1;
-}
+int fail(const std::string& message) { return handtrack::report_error("handtrack-cat", message, 1); }
 
 }  // namespace
 
@@ -141,14 +138,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_flag("--latest", latest_only, "print only the newest pose when several are waiting");
   app.add_flag("--status", status_only, "print the daemon's status and statistics once and exit");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp&) {
-    std::fputs(app.help().c_str(), stdout);
-    return 0;
-  } catch (const CLI::ParseError& e) {
-    return fail(std::string(e.what()) + " (see --help)");
-  }
+  if (const auto exit_code = handtrack::parse_command_line(app, argc, argv, "handtrack-cat", 1)) return *exit_code;
   std::signal(SIGPIPE, SIG_IGN);  // a closed pipe (| head) ends us through fwrite's error
 
   using Clock = std::chrono::steady_clock;

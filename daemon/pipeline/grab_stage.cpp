@@ -2,7 +2,7 @@
 
 #include "recorder.hpp"
 
-#include "clock.hpp"
+#include "handtrack/common/clock.hpp"
 #include "logging.hpp"
 
 #include <algorithm>

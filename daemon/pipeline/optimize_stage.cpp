@@ -1,6 +1,6 @@
 #include "optimize_stage.hpp"
 
-#include "clock.hpp"
+#include "handtrack/common/clock.hpp"
 #include "logging.hpp"
 
 namespace handtrack::daemon {

@@ -17,7 +17,7 @@
 #include "stage_watch.hpp"
 #include "thread_setup.hpp"
 
-#include "clock.hpp"
+#include "handtrack/common/clock.hpp"
 #include "logging.hpp"
 
 #include <pthread.h>

@@ -1,6 +1,6 @@
 #include "preprocess_stage.hpp"
 
-#include "clock.hpp"
+#include "handtrack/common/clock.hpp"
 #include "logging.hpp"
 
 #include <algorithm>

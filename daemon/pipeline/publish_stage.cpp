@@ -3,7 +3,7 @@
 #include "pose_record.hpp"
 #include "throttle.hpp"
 
-#include "clock.hpp"
+#include "handtrack/common/clock.hpp"
 #include "logging.hpp"
 
 #include <fmt/format.h>

@@ -2,7 +2,7 @@
 
 #include "throttle.hpp"
 
-#include "clock.hpp"
+#include "handtrack/common/clock.hpp"
 #include "logging.hpp"
 
 namespace handtrack::daemon {

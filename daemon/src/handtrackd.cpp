@@ -12,7 +12,7 @@
 #include "logging.hpp"
 #include "notify.hpp"
 
-#include <CLI/CLI.hpp>
+#include "handtrack/common/cli.hpp"
 #include <fmt/format.h>
 
 #include <csignal>
@@ -29,10 +29,7 @@ using namespace handtrack::daemon;
 
 namespace {
 
-int fail(const std::string& message) {
-  std::fprintf(stderr, "handtrackd: %s\n", message.c_str());
-  return 1;
-}
+int fail(const std::string& message) { return report_error("handtrackd", message, 1); }
 
 const char* device_state_name(ipc::DeviceState state) {
   switch (state) {
@@ -98,14 +95,7 @@ int handtrack::daemon::run_handtrackd(int argc, char** argv, const SourceFactory
   auto* level_opt = app.add_option("--log-level", log_level, "trace | debug | info | warn | error | off");
   auto* single_opt = app.add_flag("--single-thread", single_thread, "run every stage on one thread (baseline for the overlap)");
   app.add_flag("--print-config", print_config, "print the effective configuration as TOML and exit");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp&) {
-    std::fputs(app.help().c_str(), stdout);
-    return 0;
-  } catch (const CLI::ParseError& e) {
-    return fail(std::string(e.what()) + " (see --help)");
-  }
+  if (const auto exit_code = parse_command_line(app, argc, argv, "handtrackd", 1)) return *exit_code;
 
   // Command-line values over the file's; also applied again on every SIGHUP reload.
   const std::function<void(DaemonConfig&)> apply_cli = [&](DaemonConfig& c) {

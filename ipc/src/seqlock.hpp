@@ -28,17 +28,12 @@
 #include <cstring>
 #include <ctime>
 
-#include <linux/futex.h>
-#include <sys/syscall.h>
-#include <unistd.h>
+#include "handtrack/common/clock.hpp"
+#include "handtrack/common/futex.hpp"
 
 namespace handtrack::ipc::detail {
 
-inline std::int64_t monotonic_ns() noexcept {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
+using handtrack::monotonic_ns;  // common/: the one CLOCK_MONOTONIC clock of every *_ns
 
 inline std::int64_t realtime_us() noexcept {
   timespec ts{};
@@ -113,26 +108,15 @@ inline SeqRead seqlock_read(const std::atomic<std::uint64_t>& seq,
   return s1 == s0 ? SeqRead::kOk : SeqRead::kGone;
 }
 
-// --- futex (shared, not FUTEX_PRIVATE_FLAG: waiter and waker are different processes) ---------
+// --- futex: common/futex.hpp with FutexScope::kShared (waiter and waker are different processes)
 
-static_assert(sizeof(std::atomic<std::uint32_t>) == sizeof(std::uint32_t));
-
-// Sleeps while *word == expected, at most timeout_ns. Spurious returns are fine for callers.
 inline void futex_wait(const std::atomic<std::uint32_t>* word, std::uint32_t expected,
                        std::int64_t timeout_ns) noexcept {
-  if (timeout_ns <= 0) return;
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(timeout_ns / 1'000'000'000);
-  ts.tv_nsec = static_cast<long>(timeout_ns % 1'000'000'000);
-  // The kernel compares *word with `expected` atomically with queueing the waiter, so a wake
-  // between our load of the word and this call is not lost (the call returns EAGAIN at once).
-  ::syscall(SYS_futex, reinterpret_cast<const std::uint32_t*>(word), FUTEX_WAIT, expected, &ts,
-            nullptr, 0);
+  handtrack::futex_wait(word, expected, timeout_ns, FutexScope::kShared);
 }
 
 inline void futex_wake_all(std::atomic<std::uint32_t>* word) noexcept {
-  ::syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(word), FUTEX_WAKE, INT_MAX, nullptr,
-            nullptr, 0);
+  handtrack::futex_wake_all(word, FutexScope::kShared);
 }
 
 }  // namespace handtrack::ipc::detail

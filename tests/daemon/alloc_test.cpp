@@ -7,7 +7,7 @@
 // smooth): SyntheticCamera::render allocates in its motion keyframes (tools/synth), which is the
 // virtual camera's cost, not the pipeline's.
 #include "handtrack/daemon/pipeline.hpp"
-#include "handtrack/daemon/synthetic_source.hpp"
+#include "source_frames.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -60,7 +60,7 @@ using namespace std::chrono_literals;
 class ReplaySource final : public DepthSource {
  public:
   explicit ReplaySource(int frames) {
-    synth::SyntheticCamera camera(synthetic_camera_options("pinch", SourceOptions{}));
+    synth::SyntheticCamera camera(synthetic_source_options("pinch"));
     for (int i = 0; i < frames; ++i) {
       const auto depth = camera.render(i).depth;
       RawFrame raw;

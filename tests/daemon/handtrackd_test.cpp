@@ -5,7 +5,7 @@
 #include "child_process.hpp"
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/sequence.hpp"
-#include "handtrack/daemon/synthetic_source.hpp"
+#include "source_frames.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -170,7 +170,7 @@ TEST_F(Handtrackd, SyntheticSourceFingertipsMatchGroundTruth) {
   ASSERT_EQ(cat.wait(30s), 0) << cat.err();
   const auto poses = parse_lines(cat.out());
   ASSERT_EQ(poses.size(), 60U);
-  synth::SyntheticCamera camera(daemon::synthetic_camera_options("pinch", daemon::SourceOptions{}));
+  synth::SyntheticCamera camera(daemon::synthetic_source_options("pinch"));
   const double error = mean_fingertip_error(poses, [&](int frame) { return camera.render(frame).fingertips; });
   std::printf("synthetic: mean fingertip error over %zu poses: %.1f mm\n", poses.size(), error);
   EXPECT_LT(error, kMaxMeanFingertipErrorMm);
@@ -353,7 +353,7 @@ TEST_F(Handtrackd, RecordWritesASequenceDirectory) {
   EXPECT_NE(r.err.find("30 recorded"), std::string::npos) << r.err;
   const SequenceReader recorded(out);
   ASSERT_EQ(recorded.frame_count(), 30U);
-  synth::SyntheticCamera camera(daemon::synthetic_camera_options("pinch", daemon::SourceOptions{}));
+  synth::SyntheticCamera camera(daemon::synthetic_source_options("pinch"));
   for (const size_t i : {size_t{0}, size_t{29}}) {
     const auto got = recorded.depth(i);
     const auto want = camera.render(recorded.frame_number(i)).depth;
@@ -418,7 +418,7 @@ TEST_F(Handtrackd, ResolutionChangeInASequenceIsSkippedAndCounted) {
   const auto camera = synth::default_camera(320, 240);
   {
     SequenceWriter writer(seq, camera);
-    synth::SyntheticCamera small(daemon::synthetic_camera_options("pinch", daemon::SourceOptions{}));
+    synth::SyntheticCamera small(daemon::synthetic_source_options("pinch"));
     for (int i = 0; i < 20; ++i) writer.write_depth(i, small.render(i).depth);
   }
   Gray16Image big{640, 480, 1, std::vector<uint16_t>(640 * 480, 400)};

@@ -3,7 +3,7 @@
 // counted), and the newest-frame-wins policy of a live source whose frames come faster than the
 // optimizer can take them (drops counted, poses stay fresh, every frame accounted for).
 #include "handtrack/daemon/pipeline.hpp"
-#include "handtrack/daemon/synthetic_source.hpp"
+#include "source_frames.hpp"
 #include "handtrack/ipc/pose_ring_reader.hpp"
 
 #include <gtest/gtest.h>
@@ -102,8 +102,8 @@ double fingertip_error_mm(const ipc::PoseRecord& r, const Fingertips& truth) {
 
 TEST(Pipeline, ResolutionChangeMidStreamRebuildsBuffersAndKeepsTracking) {
   constexpr uint64_t kFrames = 80;
-  synth::SyntheticCamera small(synthetic_camera_options("pinch", SourceOptions{}));
-  auto big_options = synthetic_camera_options("pinch", SourceOptions{});
+  synth::SyntheticCamera small(synthetic_source_options("pinch"));
+  auto big_options = synthetic_source_options("pinch");
   big_options.camera = synth::default_camera(640, 480);
   synth::SyntheticCamera big(big_options);
   synth::SynthFrame rendered;
@@ -159,7 +159,7 @@ TEST(Pipeline, MalformedFramesAreSkippedNotPublished) {
 
 TEST(Pipeline, LiveSourceFasterThanTheOptimizerDropsOldestFramesAndStaysFresh) {
   constexpr uint64_t kFrames = 150;
-  synth::SyntheticCamera camera(synthetic_camera_options("pinch", SourceOptions{}));
+  synth::SyntheticCamera camera(synthetic_source_options("pinch"));
   synth::SynthFrame rendered;
   std::vector<RawFrame> frames(kFrames);
   for (uint64_t i = 0; i < kFrames; ++i) {

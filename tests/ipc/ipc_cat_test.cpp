@@ -107,7 +107,7 @@ TEST(HandtrackCat, MissingDaemonAndBadArgumentsFailWithOneLine) {
   const Result missing = run("--shm-name ht_cat_missing_" + std::to_string(::getpid()) + " --timeout 0.2");
   EXPECT_NE(missing.exit_code, 0);
   EXPECT_EQ(count_lines(missing.err), 1) << missing.err;
-  EXPECT_NE(missing.err.find("handtrack-cat: no handtrack shared memory"), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("handtrack-cat: error: no handtrack shared memory"), std::string::npos) << missing.err;
 
   const Result bad = run("--count banana");
   EXPECT_NE(bad.exit_code, 0);

@@ -1,6 +1,6 @@
 // oni:FILE through OpenNI2's own OniFile driver: the real recording in ../shared/data plays
 // frame by frame, and missing or corrupt files are refused with a reason.
-#include "handtrack/daemon/openni2_source.hpp"
+#include "handtrack/daemon/depth_source.hpp"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 
 namespace fs = std::filesystem;
 using handtrack::daemon::GrabStatus;
-using handtrack::daemon::make_oni_recording;
+using handtrack::daemon::make_source;
 using handtrack::daemon::RawFrame;
 using handtrack::daemon::SourceOptions;
 using namespace std::chrono_literals;
@@ -79,7 +79,7 @@ TEST(OniRecording, PlaysEveryFrameOnceAsFastAsPossible) {
   SKIP_WITHOUT_RECORDING();
   SourceOptions options;
   options.as_fast_as_possible = true;
-  auto source = make_oni_recording(kRecording.string(), options);
+  auto source = make_source("oni:" + kRecording.string(), options);
   EXPECT_FALSE(source->is_live());
   std::string why;
   ASSERT_TRUE(source->open(&why)) << why;
@@ -116,7 +116,7 @@ TEST(OniRecording, PlaysEveryFrameOnceAsFastAsPossible) {
 
 TEST(OniRecording, PlaysAtItsOwnFrameRate) {
   SKIP_WITHOUT_RECORDING();
-  auto source = make_oni_recording(kRecording.string(), SourceOptions{});
+  auto source = make_source("oni:" + kRecording.string(), SourceOptions{});
   std::string why;
   ASSERT_TRUE(source->open(&why)) << why;
   const PlayResult r = play(*source, 1000);
@@ -137,7 +137,7 @@ TEST(OniRecording, LoopsWhenAsked) {
   SourceOptions options;
   options.loop = true;
   options.as_fast_as_possible = true;
-  auto source = make_oni_recording(kRecording.string(), options);
+  auto source = make_source("oni:" + kRecording.string(), options);
   std::string why;
   ASSERT_TRUE(source->open(&why)) << why;
   const PlayResult r = play(*source, 2 * kRecordingFrames + 5);
@@ -152,7 +152,7 @@ TEST(OniRecording, ReopensFromTheStart) {
   SKIP_WITHOUT_RECORDING();
   SourceOptions options;
   options.as_fast_as_possible = true;
-  auto source = make_oni_recording(kRecording.string(), options);
+  auto source = make_source("oni:" + kRecording.string(), options);
   for (int round = 0; round < 3; ++round) {
     std::string why;
     ASSERT_TRUE(source->open(&why)) << why;
@@ -165,7 +165,7 @@ TEST(OniRecording, ReopensFromTheStart) {
 TEST(OniRecording, NonexistentFileThrowsNamingIt) {
   const std::string missing = "/nonexistent/dir/missing-recording.oni";
   try {
-    (void)make_oni_recording(missing, SourceOptions{});
+    (void)make_source("oni:" + missing, SourceOptions{});
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
@@ -177,7 +177,7 @@ TEST(OniRecording, FileRemovedAfterConstructionFailsToOpen) {
   fs::create_directories(dir);
   const fs::path file = dir / "gone.oni";
   std::ofstream(file) << "x";
-  auto source = make_oni_recording(file.string(), SourceOptions{});
+  auto source = make_source("oni:" + file.string(), SourceOptions{});
   fs::remove(file);
   std::string why;
   EXPECT_FALSE(source->open(&why));
@@ -212,7 +212,7 @@ TEST(OniRecording, CorruptFilesAreRefusedWithAReason) {
   }
   for (const fs::path& file : files) {
     SCOPED_TRACE(file.filename().string());
-    auto source = make_oni_recording(file.string(), SourceOptions{});
+    auto source = make_source("oni:" + file.string(), SourceOptions{});
     std::string why;
     const bool opened = source->open(&why);
     std::printf("%s: %s\n", file.filename().c_str(), opened ? "opened" : why.c_str());

@@ -10,7 +10,7 @@
 //   $TMP/handtrack-oni2-XXXXXX/OpenNI2/Drivers/libhandtrack_virtual_depth.so.0 -> the built driver
 // and runs the tests in a child process with LD_LIBRARY_PATH pointing there (only our driver is
 // loaded: no real camera can interfere). Nothing under /etc or /usr is touched.
-#include "handtrack/daemon/openni2_source.hpp"
+#include "handtrack/daemon/depth_source.hpp"
 #include "virtual_stage.hpp"
 
 #include <gtest/gtest.h>
@@ -32,7 +32,7 @@
 namespace fs = std::filesystem;
 using handtrack::daemon::DepthSource;
 using handtrack::daemon::GrabStatus;
-using handtrack::daemon::make_openni2_camera;
+using handtrack::daemon::make_source;
 using handtrack::daemon::RawFrame;
 using handtrack::daemon::SourceOptions;
 using namespace std::chrono_literals;
@@ -101,7 +101,7 @@ class VirtualDevice : public ::testing::Test {
 }  // namespace
 
 TEST_F(VirtualDevice, StreamsDepthFramesWithIntrinsicsFromTheDevice) {
-  auto source = make_openni2_camera("", SourceOptions{});
+  auto source = make_source("openni2", SourceOptions{});
   EXPECT_TRUE(source->is_live());
   std::string why;
   ASSERT_TRUE(source->open(&why)) << why;
@@ -142,7 +142,7 @@ TEST_F(VirtualDevice, FallsBackTo640x480At30WhenTheModeIsNotOffered) {
   options.width = 1280;
   options.height = 1024;
   options.fps = 30;
-  auto source = make_openni2_camera(kVirtualUri, options);
+  auto source = make_source(std::string("openni2:") + kVirtualUri, options);
   std::string why;
   ASSERT_TRUE(source->open(&why)) << why;
   EXPECT_EQ(source->camera().width, 640);
@@ -154,7 +154,7 @@ TEST_F(VirtualDevice, FallsBackTo640x480At30WhenTheModeIsNotOffered) {
 }
 
 TEST_F(VirtualDevice, UnknownUriWaitsForThatDevice) {
-  auto source = make_openni2_camera("handtrack-virtual://no-such-camera", SourceOptions{});
+  auto source = make_source("openni2:handtrack-virtual://no-such-camera", SourceOptions{});
   std::string why;
   EXPECT_FALSE(source->open(&why));
   EXPECT_NE(why.find("waiting for a device"), std::string::npos) << why;
@@ -165,7 +165,7 @@ TEST_F(VirtualDevice, UnknownUriWaitsForThatDevice) {
 
 TEST_F(VirtualDevice, WaitsForADeviceToBePluggedIn) {
   unplug();
-  auto source = make_openni2_camera("", SourceOptions{});
+  auto source = make_source("openni2", SourceOptions{});
   std::string why;
   // No device at all: refused, repeatedly, with the reason.
   for (int i = 0; i < 3; ++i) {
@@ -180,7 +180,7 @@ TEST_F(VirtualDevice, WaitsForADeviceToBePluggedIn) {
 }
 
 TEST_F(VirtualDevice, GrabReturnsPromptlyWhenUnpluggedDuringALongWait) {
-  auto source = make_openni2_camera("", SourceOptions{});
+  auto source = make_source("openni2", SourceOptions{});
   std::string why;
   ASSERT_TRUE(source->open(&why)) << why;
   RawFrame frame;
@@ -204,7 +204,7 @@ TEST_F(VirtualDevice, UnplugReplugCyclesLeakNoThreadsOrDescriptors) {
   const int threads_before = thread_count();
   const int fds_before = fd_count();
   {
-    auto source = make_openni2_camera("", SourceOptions{});
+    auto source = make_source("openni2", SourceOptions{});
     std::string why;
     ASSERT_TRUE(source->open(&why)) << why;
     RawFrame frame;
@@ -264,7 +264,7 @@ TEST_F(VirtualDevice, ASilentCameraIsReopened) {
   // The device stays listed but sends nothing (a hung sensor, or a driver that missed an unplug):
   // after 3 s of silence grab() reports it lost so that the pipeline reopens it.
   const fs::path stall_file = std::getenv(handtrack::test::kStallFileEnv);
-  auto source = make_openni2_camera("", SourceOptions{});
+  auto source = make_source("openni2", SourceOptions{});
   std::string why;
   ASSERT_TRUE(source->open(&why)) << why;
   RawFrame frame;
@@ -286,11 +286,11 @@ TEST_F(VirtualDevice, ASilentCameraIsReopened) {
 TEST_F(VirtualDevice, TwoSourcesShareOneOpenNI2Runtime) {
   // The runtime is process-wide: a second source (e.g. while the pipeline rebuilds) neither
   // re-initializes OpenNI2 nor shuts it down under the first.
-  auto first = make_openni2_camera("", SourceOptions{});
+  auto first = make_source("openni2", SourceOptions{});
   std::string why;
   ASSERT_TRUE(first->open(&why)) << why;
   {
-    auto second = make_openni2_camera(kVirtualUri, SourceOptions{});
+    auto second = make_source(std::string("openni2:") + kVirtualUri, SourceOptions{});
     ASSERT_TRUE(second->open(&why)) << why;
     RawFrame frame;
     EXPECT_EQ(frames_within(*second, 3, 1s, frame), 3);

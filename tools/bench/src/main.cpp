@@ -5,7 +5,7 @@
 #include "handtrack/core/part_forest.hpp"
 #include "handtrack/core/tracker.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
-#include "handtrack/tools/cli.hpp"
+#include "handtrack/common/cli.hpp"
 #include "handtrack/tools/progress.hpp"
 
 #include <nlohmann/json.hpp>
@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
   app.add_option("--forest", forest_file, "part forest for the late-fusion configuration")->check(CLI::ExistingFile);
   app.add_option("--motion", motion, "synthetic motion to track");
   app.add_option("--frames", frames, "frames per configuration")->check(CLI::Range(10, 100000));
-  if (const auto exit_code = tools::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
+  if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
 
   try {
     const PartForest forest = PartForest::load(forest_file);
@@ -115,7 +115,7 @@ int main(int argc, char** argv) {
       f << out.dump(2) << "\n";
     }
   } catch (const std::exception& e) {
-    return tools::report_error(kProgram, e.what(), 1);
+    return report_error(kProgram, e.what(), 1);
   }
   return 0;
 }

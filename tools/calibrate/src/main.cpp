@@ -5,7 +5,7 @@
 #include "handtrack/core/hand_calibration.hpp"
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/core/tracker.hpp"
-#include "handtrack/tools/cli.hpp"
+#include "handtrack/common/cli.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
   app.add_option("--frames", keep.max_frames, "frames to calibrate on")->check(CLI::Range(1, 100));
   app.add_option("--stride", keep.stride, "at least this many frames between two calibration frames")
       ->check(CLI::Range(1, 10000));
-  if (const auto exit_code = tools::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
+  if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
 
   try {
     const SequenceReader reader(sequence);
@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
                 result.scale.length, result.scale.width, result.scale.sigma, set.size(), result.evaluations,
                 took.count(), out.c_str());
   } catch (const std::exception& e) {
-    return tools::report_error(kProgram, e.what(), 1);
+    return report_error(kProgram, e.what(), 1);
   }
   return 0;
 }

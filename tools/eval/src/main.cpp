@@ -6,7 +6,7 @@
 #include "handtrack/core/tracker.hpp"
 #include "handtrack/draw/plot.hpp"
 #include "handtrack/eval/scoring.hpp"
-#include "handtrack/tools/cli.hpp"
+#include "handtrack/common/cli.hpp"
 #include "handtrack/tools/progress.hpp"
 
 #include <CLI/CLI.hpp>
@@ -69,9 +69,9 @@ int main(int argc, char** argv) {
   app.add_option("--hand-profile", hand_profile, "hand profile (handtrack-calibrate): the user's hand scale (Sec. 6)");
   bool sim_only = false;
   app.add_flag("--sim-only", sim_only, "E_sim only: drop E_col, E_lim and E_smo (ablation of Fig. 6)");
-  if (const auto exit_code = tools::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
+  if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
   if (energy == "late-fusion" && forest_file.empty() && !oracle_labels) {
-    return tools::report_error(kProgram,
+    return report_error(kProgram,
                                "--energy late-fusion needs --forest MODEL (handtrack-train-forest) or --oracle-labels", 1);
   }
   if (energy == "late-fusion") config.mode = EnergyMode::kLateFusion;
@@ -139,7 +139,7 @@ int main(int argc, char** argv) {
     // A human-readable table on stdout: the paper's Table 1 in our numbers.
     std::fputs(eval::format_table(scores, total).c_str(), stdout);
   } catch (const std::exception& e) {
-    return tools::report_error(kProgram, e.what(), 1);
+    return report_error(kProgram, e.what(), 1);
   }
   return 0;
 }

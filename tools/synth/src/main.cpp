@@ -4,7 +4,7 @@
 
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
-#include "handtrack/tools/cli.hpp"
+#include "handtrack/common/cli.hpp"
 #include "handtrack/tools/progress.hpp"
 
 #include <CLI/CLI.hpp>
@@ -28,7 +28,7 @@ namespace {
 
 constexpr const char* kProgram = "handtrack-synth";
 
-int fail(const std::string& message) { return handtrack::tools::report_error(kProgram, message, 1); }
+int fail(const std::string& message) { return handtrack::report_error(kProgram, message, 1); }
 
 // "L,W" -> SubjectScale; throws std::invalid_argument.
 handtrack::synth::SubjectScale parse_subject(const std::string& text) {
@@ -148,7 +148,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-labels", no_labels, "Do not write labels/");
   app.add_flag("--force", force, "Replace a sequence already in --out");
 
-  if (const auto exit_code = handtrack::tools::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
+  if (const auto exit_code = handtrack::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
 
   if (list) {
     for (auto name : handtrack::synth::kMotionNames) {

@@ -7,7 +7,7 @@
 #include "handtrack/draw/colormap.hpp"
 #include "handtrack/train_forest/forest_data.hpp"
 #include "handtrack/train_forest/trainer.hpp"
-#include "handtrack/tools/cli.hpp"
+#include "handtrack/common/cli.hpp"
 #include "handtrack/tools/progress.hpp"
 
 #include <CLI/CLI.hpp>
@@ -33,7 +33,7 @@ constexpr const char* kProgram = "handtrack-train-forest";
 constexpr uint64_t kHeldOutMotionSeed = 900001;
 constexpr uint64_t kHeldOutSceneSeed = 0xE7A1'0000'0000ULL;
 
-int fail(const std::string& message) { return handtrack::tools::report_error(kProgram, message, 1); }
+int fail(const std::string& message) { return handtrack::report_error(kProgram, message, 1); }
 
 
 // CPU time of the calling thread: label() timings that other processes on the machine disturb less.
@@ -213,7 +213,7 @@ int main(int argc, char** argv) {
   app.add_option("--depth-scale", depth_scale, "--apply raw depth unit in mm")->check(CLI::PositiveNumber);
   app.add_option("--far-mm", far_mm, "--apply far end of the working volume (mm)")->check(CLI::PositiveNumber);
 
-  if (const auto exit_code = handtrack::tools::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
+  if (const auto exit_code = handtrack::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
 
   try {
     if (!apply_model.empty()) {

@@ -5,7 +5,7 @@
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/core/tracker.hpp"
-#include "handtrack/tools/cli.hpp"
+#include "handtrack/common/cli.hpp"
 
 #include <CLI/CLI.hpp>
 #include <unistd.h>
@@ -29,7 +29,7 @@ constexpr int kExitBadInput = 1;  // missing or corrupt files, frame out of rang
 constexpr int kExitUsage = 2;     // wrong command line
 
 int fail(const std::string& message, int code) {
-  return handtrack::tools::report_error(kProgram, message, code);
+  return handtrack::report_error(kProgram, message, code);
 }
 
 // A usage mistake found after parsing (exit 2), as opposed to bad input data (exit 1).
@@ -239,7 +239,7 @@ int main(int argc, char** argv) {
     app.get_option(name)->excludes(seq);
   }
 
-  if (const auto exit_code = handtrack::tools::parse_command_line(app, argc, argv, kProgram, kExitUsage)) {
+  if (const auto exit_code = handtrack::parse_command_line(app, argc, argv, kProgram, kExitUsage)) {
     return *exit_code;
   }
   if (a.seq.empty() == a.depth.empty()) return fail("give either --seq DIR or --depth FILE.png (see --help)", kExitUsage);

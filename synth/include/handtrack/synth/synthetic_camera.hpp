@@ -48,6 +48,11 @@ struct SynthOptions {
   NoiseParams noise_params;
 };
 
+// The virtual camera as handtrackd's `synthetic[:MOTION]` source shows it: `frames` per pass of
+// `motion`, subject and noise from `seed`, noise on, a body behind the hand, default_camera() at
+// `fps`. Tests render the daemon's frames (and their ground truth) with the same options.
+SynthOptions live_camera_options(const std::string& motion, int frames, uint64_t seed, int fps);
+
 struct SynthFrame {
   int frame = 0;
   HandPose pose;

@@ -2,7 +2,7 @@
 // Plays a recording or the virtual camera at its own frame rate: frame i is due at start + i/fps.
 // When the consumer falls more than two frames behind, the schedule restarts from now instead of
 // bursting to catch up (a recording plays like a camera would deliver it).
-#include "clock.hpp"
+#include "handtrack/common/clock.hpp"
 
 #include <chrono>
 #include <cstdint>

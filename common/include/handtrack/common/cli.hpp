@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-namespace handtrack::tools {
+namespace handtrack {
 
 // Writes "PROGRAM: error: MESSAGE" as one line (newlines folded) and returns `code`.
 inline int report_error(const std::string& program, const std::string& message, int code) {
@@ -37,4 +37,4 @@ inline std::optional<int> parse_command_line(CLI::App& app, int argc, char** arg
   return std::nullopt;
 }
 
-}  // namespace handtrack::tools
+}  // namespace handtrack

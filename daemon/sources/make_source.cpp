@@ -1,7 +1,8 @@
-// make_source: SPEC.md "Sources" -> a DepthSource.
+// make_source: SPEC.md "Sources" -> a DepthSource, the one public entry point for sources. Each
+// scheme's source lives in its own folder (openni2/, oni/, sequence/, synthetic/).
 #include "handtrack/daemon/depth_source.hpp"
-#include "handtrack/daemon/openni2_source.hpp"
-#include "handtrack/daemon/synthetic_source.hpp"
+
+#include "source_factories.hpp"
 
 #include <stdexcept>
 

@@ -275,4 +275,16 @@ RgbImage preview_image(const SynthFrame& frame) {
   return img;
 }
 
+SynthOptions live_camera_options(const std::string& motion, int frames, uint64_t seed, int fps) {
+  SynthOptions o;
+  o.motion = motion;
+  o.frames = frames;
+  o.seed = seed;
+  o.noise = true;
+  o.background = Background::kBody;
+  o.camera = default_camera();
+  o.camera.fps = fps;
+  return o;
+}
+
 }  // namespace handtrack::synth

@@ -1,8 +1,19 @@
-// synthetic[:MOTION]: the virtual camera of handtrack::synth as a DepthSource.
-#include "handtrack/daemon/synthetic_source.hpp"
+// synthetic[:MOTION]: the virtual camera of handtrack::synth as a DepthSource, so that the daemon,
+// scripts/demo and the tests run without hardware (like libcamera's vimc).
+//
+//   synthetic          the seven Dexter 1 motions one after another, options.synthetic_frames each
+//   synthetic:MOTION   one motion, played back and forth for ever
+//
+// Frames are paced at the camera's fps unless options.as_fast_as_possible. Frame i is a pure
+// function of (motion, options.synthetic_frames, options.seed, i): synth::live_camera_options()
+// renders the same frame with its ground truth.
+#include "../source_factories.hpp"
 
-#include "clock.hpp"
-#include "pacer.hpp"
+#include "handtrack/synth/synthetic_camera.hpp"
+
+#include "../pacer.hpp"
+
+#include "handtrack/common/clock.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,26 +22,18 @@
 
 namespace handtrack::daemon {
 
-synth::SynthOptions synthetic_camera_options(const std::string& motion, const SourceOptions& options) {
-  synth::SynthOptions o;
-  o.motion = motion;
-  o.frames = options.synthetic_frames;
-  o.seed = options.seed;
-  o.noise = true;
-  o.background = synth::Background::kBody;
-  o.camera = synth::default_camera();
-  o.camera.fps = options.fps;
-  return o;
-}
-
 namespace {
+
+synth::SynthOptions camera_options(const std::string& motion, const SourceOptions& options) {
+  return synth::live_camera_options(motion, options.synthetic_frames, options.seed, options.fps);
+}
 
 class SyntheticSource final : public DepthSource {
  public:
   SyntheticSource(const std::string& motion, const SourceOptions& options) : motion_(motion), options_(options) {
     if (motion.empty()) {
       for (const auto name : synth::kMotionNames) {
-        cameras_.emplace_back(synthetic_camera_options(std::string(name), options));
+        cameras_.emplace_back(camera_options(std::string(name), options));
       }
     } else {
       const auto& names = synth::kMotionNames;
@@ -39,7 +42,7 @@ class SyntheticSource final : public DepthSource {
         for (const auto name : names) known += (known.empty() ? "" : ", ") + std::string(name);
         throw std::invalid_argument("synthetic:" + motion + ": unknown motion (known: " + known + ")");
       }
-      cameras_.emplace_back(synthetic_camera_options(motion, options));
+      cameras_.emplace_back(camera_options(motion, options));
     }
   }
 

@@ -1,9 +1,10 @@
 // seq:DIR: a sequence directory (SPEC.md) played at its camera.json fps, or as fast as possible.
-#include "clock.hpp"
+#include "../pacer.hpp"
+#include "../source_factories.hpp"
+
+#include "handtrack/common/clock.hpp"
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/sequence.hpp"
-#include "handtrack/daemon/synthetic_source.hpp"
-#include "pacer.hpp"
 
 #include <optional>
 #include <string>

@@ -35,12 +35,6 @@ std::shared_ptr<spdlog::logger> logger() {
 
 }  // namespace
 
-int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
 struct Runtime::Listeners final : openni::OpenNI::DeviceConnectedListener,
                                   openni::OpenNI::DeviceDisconnectedListener,
                                   openni::OpenNI::DeviceStateChangedListener {
@@ -120,11 +114,8 @@ std::vector<std::string> Runtime::device_uris() {
 }
 
 void Runtime::on_connected(const char* uri) {
+  // A waiting camera source finds the new device by itself: its open() is retried every second.
   logger()->info("OpenNI2: device connected: {}", uri ? uri : "?");
-  std::lock_guard lock(watch_mutex_);
-  for (const auto& weak : watches_) {
-    if (auto watch = weak.lock()) watch->arrivals.fetch_add(1, std::memory_order_release);
-  }
 }
 
 void Runtime::on_disconnected(const char* uri) {

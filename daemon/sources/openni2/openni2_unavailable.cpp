@@ -1,5 +1,5 @@
 // Built when OpenNI2 was not found at configure time: both factories refuse with a clear message.
-#include "handtrack/daemon/openni2_source.hpp"
+#include "../source_factories.hpp"
 
 #include <stdexcept>
 

@@ -22,7 +22,6 @@ struct DeviceWatch {
   std::mutex uri_mutex;
   std::string uri;                    // the open device's URI; empty: none open
   std::atomic<bool> lost{false};      // the device went away (disconnected or in error)
-  std::atomic<uint64_t> arrivals{0};  // devices that appeared since the watch was made
 };
 
 class Runtime {
@@ -56,8 +55,5 @@ class Runtime {
   std::mutex watch_mutex_;
   std::vector<std::weak_ptr<DeviceWatch>> watches_;
 };
-
-// Monotonic clock in ns (CLOCK_MONOTONIC, the capture_ns clock of RawFrame).
-int64_t monotonic_ns();
 
 }  // namespace handtrack::daemon::openni2
