@@ -23,10 +23,22 @@ std::string CameraIntrinsics::problem() const {
 }
 
 DepthImage DepthImage::from_raw(const CameraIntrinsics& camera, const std::vector<uint16_t>& raw) {
-  DepthImage image{camera, std::vector<float>(raw.size())};
-  const auto scale = static_cast<float>(camera.depth_scale_mm);
-  for (size_t i = 0; i < raw.size(); ++i) image.depth_mm[i] = static_cast<float>(raw[i]) * scale;
+  DepthImage image;
+  image.assign_raw(camera, raw, 0.0F, 0.0F);
   return image;
+}
+
+size_t DepthImage::assign_raw(const CameraIntrinsics& c, const std::vector<uint16_t>& raw, float near_mm, float far_mm) {
+  camera = c;
+  depth_mm.resize(raw.size());
+  const auto scale = static_cast<float>(c.depth_scale_mm);
+  size_t in_volume = 0;
+  for (size_t i = 0; i < raw.size(); ++i) {
+    const float d = static_cast<float>(raw[i]) * scale;
+    depth_mm[i] = d;
+    in_volume += (d >= near_mm && d <= far_mm) ? 1 : 0;
+  }
+  return in_volume;
 }
 
 std::vector<uint16_t> DepthImage::to_raw() const {

@@ -28,7 +28,7 @@ OptimizerResult AdaptiveGradientAscent::maximise(const PoseEnergy& energy, const
       double s = step[j];
       if (agreement > 0.0) s *= config_.grow;
       if (agreement < 0.0) s *= config_.shrink;
-      step[j] = std::clamp(s, initial_step[j] * 0.01, initial_step[j] * config_.max_step_factor);
+      step[j] = std::clamp(s, initial_step[j] * config_.min_step_factor, initial_step[j] * config_.max_step_factor);
       // After a flip the derivative is forgotten, so the next iteration neither grows nor shrinks.
       previous[j] = agreement < 0.0 ? 0.0 : g;
       if (agreement >= 0.0 && g != 0.0) theta[j] += g > 0.0 ? step[j] : -step[j];

@@ -299,47 +299,6 @@ PartForest PartForest::from_bytes(std::span<const uint8_t> bytes, const std::str
   }
 }
 
-template <typename Accumulate>
-void PartForest::descend(const DepthInput& input, int x, int y, Accumulate&& accumulate) const {
-  const int w = input.camera.width;
-  const int h = input.camera.height;
-  const float* depth = input.filtered_mm.data();
-  const uint8_t* mask = input.hand_mask.data();
-  const float background = info_.background_mm;
-  // d_I(p): the filtered depth on the hand mask, the background constant elsewhere.
-  const auto probe = [&](int px, int py) -> float {
-    if (static_cast<unsigned>(px) >= static_cast<unsigned>(w) || static_cast<unsigned>(py) >= static_cast<unsigned>(h)) {
-      return background;
-    }
-    const size_t i = static_cast<size_t>(py) * static_cast<size_t>(w) + static_cast<size_t>(px);
-    return mask[i] != 0 ? depth[i] : background;
-  };
-  const float d = depth[static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x)];
-  // Offsets u / d(x), scaled from the reference focal length to this camera's.
-  const int32_t kx = probe_scale(input.camera.fx / info_.reference_fx, d);
-  const int32_t ky = probe_scale(input.camera.fy / info_.reference_fy, d);
-  for (const PartForestTree& tree : trees_) {
-    const PartForestNode* nodes = tree.nodes.data();
-    uint32_t i = 0;
-    while (!nodes[i].is_leaf()) {
-      const PartForestNode& n = nodes[i];
-      const float a = probe(probe_coordinate(x, n.u[0], kx), probe_coordinate(y, n.u[1], ky));
-      const float b = probe(probe_coordinate(x, n.v[0], kx), probe_coordinate(y, n.v[1], ky));
-      i = n.child + ((a - b) < n.threshold ? 0U : 1U);
-    }
-    accumulate(tree.leaves[nodes[i].leaf_index()]);
-  }
-}
-
-std::array<float, kPartForestClasses> PartForest::distribution(const DepthInput& input, int x, int y) const {
-  std::array<float, kPartForestClasses> p{};
-  const float scale = 1.0F / (65535.0F * static_cast<float>(trees_.size()));
-  descend(input, x, y, [&](const PartForestLeaf& leaf) {
-    for (int c = 0; c < kPartForestClasses; ++c) p[static_cast<size_t>(c)] += scale * leaf[static_cast<size_t>(c)];
-  });
-  return p;
-}
-
 void PartForest::classify_batch(const Crop& crop, const Site* sites, int count, uint8_t* out) const {
   const float* depth = crop.depth_mm;
   const float background = info_.background_mm;

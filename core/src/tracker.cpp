@@ -19,6 +19,21 @@ constexpr std::array<double, 4> kClosedFinger = {0.0, 1.3, 1.5, 0.9};
 constexpr double kClosedFingersInFrontMm = 40.0;
 // Pinch strength falls from 1 (tips touching) to 0 at this surface distance.
 constexpr double kPinchOpenMm = 40.0;
+
+// confidence(): the share of the hand's data explained by the fitted model, times the share of
+// model Gaussians that sit on data. Not from the paper: set with the recovery check of issue 4
+// (docs/TRACKER.md "Recovery") and kept since.
+// A model Gaussian whose centre is nearer the camera than this is behind it (cannot project).
+constexpr double kMinProjectableDepthMm = 1.0;
+// A data leaf is explained by a model Gaussian that covers it in the image and whose surface is
+// within this depth of the leaf: kExplainSigmas model sigmas plus kExplainMarginMm of noise.
+constexpr double kExplainSigmas = 2.0;
+constexpr double kExplainMarginMm = 10.0;
+// A model Gaussian "floats" (counts against the fit) when the data under its centre is missing or
+// farther than its surface by more than kFloatSigmas sigmas plus kFloatMarginMm; data nearer the
+// camera merely occludes it.
+constexpr double kFloatSigmas = 3.0;
+constexpr double kFloatMarginMm = 20.0;
 }  // namespace
 
 const char* to_string(EnergyMode mode) {
@@ -108,14 +123,14 @@ double PoseTracker::confidence(const DepthInput& input, const PosedHand& hand) c
   for (int p = 0; p < m; ++p) {
     const Vector3d& mu = hand.centre(p);
     const double sigma_h = gaussians[static_cast<size_t>(p)].sigma_mm;
-    if (mu.z() < 1.0) {
+    if (mu.z() < kMinProjectableDepthMm) {
       ++bad;
       projected[static_cast<size_t>(p)] = {-1e9, -1e9, 0, 0, 0};
       continue;
     }
     const Eigen::Vector2d uv = cam.project(mu);
     projected[static_cast<size_t>(p)] = {uv.x(), uv.y(), sigma_h * cam.focal() / mu.z(), mu.z() - sigma_h,
-                                         2.0 * sigma_h + 10.0};
+                                         kExplainSigmas * sigma_h + kExplainMarginMm};
     // A model Gaussian over no data or over background floats in empty space; one behind data
     // nearer the camera is merely occluded.
     const int u = static_cast<int>(std::lround(uv.x()));
@@ -126,7 +141,7 @@ double PoseTracker::confidence(const DepthInput& input, const PosedHand& hand) c
     }
     const float d = input.filtered_mm[static_cast<size_t>(v) * cam.width + u];
     const double surface = mu.z() - sigma_h;
-    if (d <= 0.0F || d > surface + 3.0 * sigma_h + 20.0) ++bad;
+    if (d <= 0.0F || d > surface + kFloatSigmas * sigma_h + kFloatMarginMm) ++bad;
   }
   double covered = 0.0;
   double total = 0.0;

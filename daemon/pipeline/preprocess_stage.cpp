@@ -45,18 +45,9 @@ void PreprocessStage::step(Frame& f) {
       stream_width_ = cam.width;
       stream_height_ = cam.height;
     }
-    // Raw units to mm; count pixels inside the working volume (Sec. 4: 150..600 mm).
-    f.depth.camera = cam;
-    f.depth.depth_mm.resize(n);  // no reallocation once a resolution has been seen
-    const auto scale = static_cast<float>(cam.depth_scale_mm);
-    const auto near = static_cast<float>(input_config_.near_mm);
-    const auto far = static_cast<float>(input_config_.far_mm);
-    size_t in_volume = 0;
-    for (size_t i = 0; i < n; ++i) {
-      const float d = static_cast<float>(f.raw.depth_raw[i]) * scale;
-      f.depth.depth_mm[i] = d;
-      in_volume += (d >= near && d <= far) ? 1 : 0;
-    }
+    // Raw units to mm; pixels inside the working volume (Sec. 4: 150..600 mm).
+    const size_t in_volume = f.depth.assign_raw(cam, f.raw.depth_raw, static_cast<float>(input_config_.near_mm),
+                                                static_cast<float>(input_config_.far_mm));
     if (in_volume == 0) {
       f.empty = true;
     } else {

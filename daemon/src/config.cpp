@@ -174,8 +174,10 @@ const std::vector<Field>& fields() {
      "step growth while the derivative's sign holds (adaptive step, Sec. 5)", true},
     {"tracker.optimizer.shrink", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.optimizer.shrink; }}, 0.01, 1,
      "step shrink when the derivative's sign flips", true},
+    {"tracker.optimizer.min_step_factor", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.optimizer.min_step_factor; }}, 1e-6, 1,
+     "steps stay within [initial * this, initial * max_step_factor]", true},
     {"tracker.optimizer.max_step_factor", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.optimizer.max_step_factor; }}, 1, 1000,
-     "steps stay within [initial/100, initial * this]", true},
+     "steps stay within [initial * min_step_factor, initial * this]", true},
     // [tracker.scale] (Sec. 6)
     {"tracker.scale.length", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.scale.length; }}, 0.5, 2,
      "hand model length scale (Sec. 6)", true},

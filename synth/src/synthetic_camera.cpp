@@ -18,13 +18,6 @@ constexpr uint64_t kSubjectStream = 0x5B1EC7;
 constexpr uint64_t kNoiseStream = 0x0015E;
 constexpr double kSubjectSpread = 0.10;  // random subjects: scales within +-10 % (module brief)
 
-// SPEC.md's example camera (a Senz3D-like 320x240 sensor).
-constexpr double kSpecFx = 224.502;
-constexpr double kSpecFy = 230.494;
-constexpr double kSpecWidth = 320.0;
-constexpr double kSpecHeight = 240.0;
-constexpr double kSpecFps = 60.0;
-
 PlanePatch make_patch(const Vector3d& origin, const Vector3d& normal, double half_u, double half_v) {
   PlanePatch p;
   p.origin = origin;
@@ -62,12 +55,12 @@ CameraIntrinsics default_camera(int width, int height) {
   CameraIntrinsics c;
   c.width = width;
   c.height = height;
-  c.fx = kSpecFx * width / kSpecWidth;
-  c.fy = kSpecFy * height / kSpecHeight;
+  c.fx = SpecCamera::kFx * width / SpecCamera::kWidth;
+  c.fy = SpecCamera::kFy * height / SpecCamera::kHeight;
   c.cx = 0.5 * width;
   c.cy = 0.5 * height;
   c.depth_scale_mm = 1.0;
-  c.fps = kSpecFps;
+  c.fps = SpecCamera::kFps;
   return c;
 }
 

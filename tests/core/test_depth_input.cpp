@@ -247,3 +247,20 @@ TEST(Projection, UnprojectInvertsProjectAndSigmaScalesWithInverseDepth) {
 
 }  // namespace
 }  // namespace handtrack
+
+// Raw sensor units to mm, in place (the daemon's preprocess stage): the scale applied, 0 kept as
+// "no depth", the working-volume count right at both limits, and no reallocation once sized.
+TEST(DepthImageFromRaw, ScalesInPlaceAndCountsTheWorkingVolume) {
+  handtrack::CameraIntrinsics cam;
+  cam.width = 4;
+  cam.height = 1;
+  cam.depth_scale_mm = 0.125;  // SR305
+  handtrack::DepthImage image;
+  const std::vector<uint16_t> raw = {0, 1200, 4800, 4808};  // 0, 150, 600, 601 mm
+  EXPECT_EQ(image.assign_raw(cam, raw, 150.0F, 600.0F), 2U);
+  EXPECT_EQ(image.depth_mm, (std::vector<float>{0.0F, 150.0F, 600.0F, 601.0F}));
+  const float* buffer = image.depth_mm.data();
+  EXPECT_EQ(image.assign_raw(cam, {0, 0, 0, 0}, 150.0F, 600.0F), 0U);
+  EXPECT_EQ(image.depth_mm.data(), buffer) << "reallocated";
+  EXPECT_EQ(handtrack::DepthImage::from_raw(cam, raw).depth_mm[2], 600.0F);
+}

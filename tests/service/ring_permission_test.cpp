@@ -16,6 +16,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
+#include <filesystem>
 #include <cstdio>
 #include <string>
 #include <thread>
@@ -55,6 +57,37 @@ int read_as(const std::string& name, const std::vector<gid_t>& supplementary) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+// What the daemon's user runs, copied to a fresh directory under /tmp that every user may enter:
+// the checkout (and so the build tree) may sit in a directory the service user cannot reach
+// (root's home, any mode-0700 directory), and exec() of a binary there fails for it.
+class ReachableCopy {
+ public:
+  ReachableCopy() {
+    char pattern[] = "/tmp/handtrack-svc-XXXXXX";
+    if (::mkdtemp(pattern) == nullptr) return;
+    dir_ = pattern;
+    std::error_code ec;
+    std::filesystem::permissions(dir_, std::filesystem::perms(0755), ec);
+    std::filesystem::copy_file(HANDTRACKD, dir_ / "handtrackd", ec);
+    if (!ec) std::filesystem::copy_file(std::string(HANDTRACK_SOURCE_DIR) + "/data/handtrackd.toml",
+                                        dir_ / "handtrackd.toml", ec);
+    ok_ = !ec;
+  }
+  ~ReachableCopy() {
+    std::error_code ec;
+    if (!dir_.empty()) std::filesystem::remove_all(dir_, ec);
+  }
+  ReachableCopy(const ReachableCopy&) = delete;
+  ReachableCopy& operator=(const ReachableCopy&) = delete;
+  [[nodiscard]] bool ok() const { return ok_; }
+  [[nodiscard]] std::string daemon() const { return (dir_ / "handtrackd").string(); }
+  [[nodiscard]] std::string config() const { return (dir_ / "handtrackd.toml").string(); }
+
+ private:
+  std::filesystem::path dir_;
+  bool ok_ = false;
+};
+
 }  // namespace
 
 TEST(ServiceRing, GroupMembersReadPosesOthersAreRefused) {
@@ -62,14 +95,17 @@ TEST(ServiceRing, GroupMembersReadPosesOthersAreRefused) {
   const std::string name = "htsvc_perm_" + std::to_string(::getpid());
   const std::string path = "/dev/shm/" + name;
   ::unlink(path.c_str());
+  const ReachableCopy copy;
+  ASSERT_TRUE(copy.ok()) << "cannot copy handtrackd and its configuration to /tmp";
 
   const pid_t daemon = ::fork();
   if (daemon == 0) {
     if (::setgroups(0, nullptr) != 0 || ::setgid(kDaemonGid) != 0 || ::setuid(kDaemonUid) != 0) ::_exit(90);
     const int devnull = ::open("/dev/null", O_WRONLY);
     ::dup2(devnull, STDOUT_FILENO);
-    const std::string config = std::string(HANDTRACK_SOURCE_DIR) + "/data/handtrackd.toml";
-    ::execl(HANDTRACKD, HANDTRACKD, "--config", config.c_str(), "--source", "synthetic:pinch",
+    const std::string exe = copy.daemon();
+    const std::string config = copy.config();
+    ::execl(exe.c_str(), exe.c_str(), "--config", config.c_str(), "--source", "synthetic:pinch",
             "--shm-name", name.c_str(), "--log-level", "warn", static_cast<char*>(nullptr));
     ::_exit(91);
   }

@@ -179,7 +179,8 @@ int main(int argc, char** argv) {
   int eval_frames = 30;
   int eval_scenes = 300;
   int stride = PartForestOptions{}.stride_px;
-  double fx = 476.007, fy = 476.007, cx = 313.683, cy = 242.755, depth_scale = 0.125, far_mm = 900.0;
+  double fx = Sr305Camera::kFx, fy = Sr305Camera::kFy, cx = Sr305Camera::kCx, cy = Sr305Camera::kCy,
+         depth_scale = Sr305Camera::kDepthScaleMm, far_mm = 900.0;
   app.add_option("--out", out, "Model file to write (training)");
   app.add_option("--trees", train.trees, "Number of trees (paper: 3)")->check(CLI::Range(1, 64));
   app.add_option("--depth", train.max_depth, "Maximum tree depth (paper: 22)")->check(CLI::Range(1, 40));

@@ -8,9 +8,8 @@
 
 #include <Eigen/Core>
 
-#include <algorithm>
 #include <cstdint>
-#include <limits>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -83,9 +82,16 @@ class FixedLabels final : public PixelLabeller {
   const std::vector<uint8_t>* labels_;
 };
 
+// The four steps from a depth image to C_I: median filter, working volume, hand segmentation,
+// quadtree Gaussians (and E(C_I,C_I)). Each builder owns its scratch, reused from frame to frame:
+// after the first frames of a resolution, build() allocates nothing.
+// Thread roles: reentrant (the daemon gives each pipeline frame its own builder).
 class DepthInputBuilder {
  public:
   explicit DepthInputBuilder(DepthInputConfig config = {});
+  ~DepthInputBuilder();
+  DepthInputBuilder(DepthInputBuilder&&) noexcept;
+  DepthInputBuilder& operator=(DepthInputBuilder&&) noexcept;
 
   // Builds C_I for one frame. With a `labeller`, the hand's pixels get part labels and each
   // quadtree leaf the majority label of its pixels (Sec. 4.3). Storage is reused between calls.
@@ -95,68 +101,14 @@ class DepthInputBuilder {
   [[nodiscard]] const DepthInputConfig& config() const { return config_; }
 
  private:
-  void median_filter(const DepthImage& depth);
-  void median_3x3(const DepthImage& depth);
-  // Sorts the column triples (a[u], b[u], c[u]) of three rows into lo[u] <= mid[u] <= hi[u].
-  static void sort_columns(const float* __restrict a, const float* __restrict b, const float* __restrict c, int n,
-                           float* __restrict lo, float* __restrict mid, float* __restrict hi);
-  void median_any(const DepthImage& depth);
-  void segment(const std::optional<HandHint>& hint);
-  void build_quadtree();
-  // Share of a connected surface's outline where it goes on just beyond the far plane.
-  [[nodiscard]] double far_plane_cut_fraction(int blob) const;
-  void quad(int x, int y, int side);
-
+  struct Steps;  // the four algorithms and their scratch (core/src)
   DepthInputConfig config_;
   DepthInput out_;
-  std::vector<int> component_;
-  std::vector<int> stack_;
-  // Inclusive pixel bounding box; empty while u1 < u0.
-  struct PixelBox {
-    int u0, v0, u1, v1;
-    void add(int u, int v) {
-      u0 = std::min(u0, u);
-      v0 = std::min(v0, v);
-      u1 = std::max(u1, u);
-      v1 = std::max(v1, v);
-    }
-  };
-  PixelBox hand_box_{0, 0, -1, -1};                 // the segmented hand's pixels
-  Eigen::Vector3d hand_sum_ = Eigen::Vector3d::Zero();  // sum of their 3D points
-  std::vector<double> ray_u_;                       // (u - c_x) / f_x per image column
-  // The hand's depths per smallest quadtree cell (build_quadtree).
-  struct CellStats {
-    int count = 0;
-    float lo = std::numeric_limits<float>::infinity();
-    float hi = 0.0F;
-    double sum = 0.0;
-    void add(float d) {
-      ++count;
-      sum += d;
-      lo = std::min(lo, d);
-      hi = std::max(hi, d);
-    }
-    void merge(const CellStats& o) {
-      count += o.count;
-      sum += o.sum;
-      lo = std::min(lo, o.lo);
-      hi = std::max(hi, o.hi);
-    }
-  };
-  struct CellGrid {
-    int x0 = 0, y0 = 0;  // image pixel of cell (0, 0)
-    int side = 1;        // cell side, px
-    int columns = 0;
-    std::vector<CellStats> stats;
-    CellStats& at(int i, int j) { return stats[static_cast<size_t>(j) * static_cast<size_t>(columns) + static_cast<size_t>(i)]; }
-  } cells_;
-  std::vector<float> window_;              // median_any's window
-  std::vector<float> clean_;               // median_3x3's input, non-finite samples as 0
-  std::vector<float> lo_, mid_, hi_;       // median_3x3's sorted column triples
-  std::vector<float> unclamped_mm_;  // median-filtered depth before the working volume
+  std::unique_ptr<Steps> steps_;
 };
 
-// E(C_a, C_b) of paper eq. 3 for two sets of image-plane Gaussians.
+// E(C_I, C_I) of paper eq. 3 for a set of image-plane Gaussians (allocates its scratch: the
+// builder keeps its own).
 double image_self_similarity(const std::vector<ImageGaussian>& gaussians);
 
 }  // namespace handtrack

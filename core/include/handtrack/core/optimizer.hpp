@@ -17,7 +17,8 @@ struct OptimizerConfig {
   double step_angle_rad = 0.05;
   double grow = 1.2;
   double shrink = 0.5;
-  double max_step_factor = 8.0;     // steps stay within [initial/100, initial * max_step_factor]
+  double min_step_factor = 0.01;    // steps stay within [initial * min_step_factor,
+  double max_step_factor = 8.0;     //                    initial * max_step_factor]
 };
 
 struct OptimizerResult {

@@ -74,8 +74,8 @@ struct PartForestTree {
 };
 
 struct PartForestInfo {
-  float reference_fx = 224.502F;  // focal lengths the offsets were trained at (SPEC.md camera)
-  float reference_fy = 230.494F;
+  float reference_fx = static_cast<float>(SpecCamera::kFx);  // focal lengths the offsets were trained at
+  float reference_fy = static_cast<float>(SpecCamera::kFy);
   float background_mm = 4000.0F;  // depth read by probes outside the image or off the hand
   std::string metadata;           // free text: how the model was trained
 };
@@ -131,10 +131,6 @@ class PartForest final : public PixelLabeller {
   // 0 elsewhere. No allocation once `labels` has the image's size.
   void label(const DepthInput& input, std::vector<uint8_t>& labels) const override;
 
-  // Mean of the trees' leaf distributions at pixel (x, y) of the input, which must be on the hand
-  // mask (probabilities summing to ~1).
-  [[nodiscard]] std::array<float, kPartForestClasses> distribution(const DepthInput& input, int x, int y) const;
-
   [[nodiscard]] const std::vector<PartForestTree>& trees() const { return trees_; }
   [[nodiscard]] const PartForestInfo& info() const { return info_; }
   [[nodiscard]] const PartForestOptions& options() const { return options_; }
@@ -143,8 +139,6 @@ class PartForest final : public PixelLabeller {
   [[nodiscard]] int max_depth() const;
 
  private:
-  template <typename Accumulate>
-  void descend(const DepthInput& input, int x, int y, Accumulate&& accumulate) const;
   static constexpr int kBatch = 32;  // pixels classified together (lockstep descent)
   struct Site {
     int x = 0;  // the pixel classified

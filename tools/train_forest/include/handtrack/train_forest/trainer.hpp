@@ -27,7 +27,7 @@ struct TrainOptions {
   int thresholds_per_feature = 20;  // each random (u, v) is tried with this many thresholds
   int min_leaf_samples = 8;     // a split must leave at least this many samples on each side
   int max_node_samples = 20000; // larger nodes choose their split on a random subset of this size
-  float max_offset_pxmm = 60.0F * 224.502F;  // |u|, |v| per axis: 60 mm at the reference focal length
+  float max_offset_pxmm = 60.0F * static_cast<float>(SpecCamera::kFx);  // |u|, |v| per axis: 60 mm at the reference focal length
   float unary_fraction = 0.25F; // share of features with v = 0, i.e. f = d(x + u/d) - d(x)
   uint64_t seed = 1;
   int threads = 2;

@@ -1,0 +1,319 @@
+#include "hand_segmentation.hpp"
+
+#include "handtrack/core/hand_model.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+
+namespace handtrack {
+
+namespace {
+
+using Eigen::Vector3d;
+
+// Radius around the palm centre that holds the whole hand, in hand lengths: an extended middle
+// fingertip is ~0.75 hand lengths from the palm centre; the margin allows for motion between frames
+// and a palm centre that is off.
+constexpr double kHandRadiusInLengths = 1.0;
+// Distance from the palm centre found by the distance transform down to the wrist cut, in hand
+// lengths (an open palm's centre is about a quarter hand length above the wrist).
+constexpr double kWristBelowPalmCentre = 0.25;
+// A hand is at most this many default hand lengths long (subjects vary by about 10 %).
+constexpr double kHandLengthMargin = 1.1;
+// The forearm is cut this far below the wrist joint (mm): the wrist's own surface stays in.
+constexpr double kWristCutMarginMm = 10.0;
+// A blob whose outline runs along the far plane of the working volume for more than this share
+// is a larger surface (a shoulder, a desk) reaching into the volume, not a hand in front of one.
+// Measured: synthetic hands with their forearms 0-0.10, the shoulder of the .oni recording
+// 0.18-0.24; a real hand straddling the far plane (SR305 231615/100: 0.25) is missed until it
+// comes nearer, which is what a working volume means.
+constexpr double kMaxFarPlaneCut = 0.15;
+// Pixels this close to the image border mark the end of a blob where the arm leaves the image.
+constexpr int kBorderPx = 3;
+
+// Two-pass 3-4 chamfer distance transform in place: nonzero cells get their distance (in thirds of
+// a pixel) to the nearest zero cell.
+void chamfer_distance(std::vector<int>& d, int w, int h) {
+  const auto at = [&](int u, int v) -> int& { return d[static_cast<size_t>(v) * w + u]; };
+  const auto relax = [&](int u, int v, int du, int dv, int cost) {
+    const int uu = u + du;
+    const int vv = v + dv;
+    const int other = (uu < 0 || vv < 0 || uu >= w || vv >= h) ? 0 : at(uu, vv);
+    at(u, v) = std::min(at(u, v), other + cost);
+  };
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      if (at(u, v) == 0) continue;
+      relax(u, v, -1, 0, 3);
+      relax(u, v, 0, -1, 3);
+      relax(u, v, -1, -1, 4);
+      relax(u, v, 1, -1, 4);
+    }
+  }
+  for (int v = h - 1; v >= 0; --v) {
+    for (int u = w - 1; u >= 0; --u) {
+      if (at(u, v) == 0) continue;
+      relax(u, v, 1, 0, 3);
+      relax(u, v, 0, 1, 3);
+      relax(u, v, 1, 1, 4);
+      relax(u, v, -1, 1, 4);
+    }
+  }
+}
+
+// Pixels checked at once when scanning for depth in the working volume (0 outside it).
+constexpr int kScanChunk = 16;
+
+// True when none of the kScanChunk depths from `d` is in the working volume: one vectorised max.
+bool nothing_in(const float* d) {
+  float m = 0.0F;
+  for (int k = 0; k < kScanChunk; ++k) m = std::max(m, d[k]);
+  return m <= 0.0F;
+}
+
+}  // namespace
+
+void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
+                            const std::optional<HandHint>& hint, DepthInput& out) {
+  const auto& cam = out.camera;
+  const int w = cam.width;
+  const int h = cam.height;
+  const auto n = static_cast<size_t>(w) * h;
+  const auto& d = out.filtered_mm;
+  out.hand_mask.assign(n, 0);
+  out.hand_pixels = 0;
+  const auto point = [&](size_t i) {
+    return cam.unproject(static_cast<double>(i % w), static_cast<double>(i / w), d[i]);
+  };
+  const double hand_radius = kHandRadiusInLengths * config.hand_length_mm;
+
+  Vector3d centre;
+  Vector3d axis;
+  Vector3d wrist;
+  bool found = false;
+  if (hint) {
+    centre = hint->palm_centre_mm;
+    axis = hint->finger_axis;
+    wrist = hint->wrist_mm;
+    found = true;
+  }
+  // Keeps the pixels near `centre` and above the forearm cut; sets hand_box_ (their bounding box)
+  // and hand_sum_ (the sum of their 3D points). The cut is the wrist plane, but never lower than
+  // one (generous) hand length below the farthest point along the axis: a wrist that drifted down
+  // the forearm must not let the forearm in, or the model follows it further down. Returns how many
+  // pixels it kept. Two passes over the image, no per-pixel lists: nothing grows with the hand.
+  const auto select = [&]() {
+    std::fill(out.hand_mask.begin(), out.hand_mask.end(), 0);
+    // Unprojection by ray: p = (r_u d, r_v d, d) with r_u = (u - c_x) / f_x, r_v = (v - c_y) / f_y.
+    ray_u_.resize(static_cast<size_t>(w));
+    for (int u = 0; u < w; ++u) ray_u_[static_cast<size_t>(u)] = (u - cam.cx) / cam.fx;
+    const auto ray_v = [&](int v) { return (v - cam.cy) / cam.fy; };
+    const auto ray_point = [&](int u, double r_v, float depth) {
+      return Vector3d(ray_u_[static_cast<size_t>(u)] * depth, r_v * depth, depth);
+    };
+    PixelBox near{w, h, -1, -1};
+    double tip = -std::numeric_limits<double>::infinity();
+    for (int v = 0; v < h; ++v) {
+      const float* row = d.data() + static_cast<size_t>(v) * w;
+      const double r_v = ray_v(v);
+      for (int u = 0; u < w; ++u) {
+        if (u % kScanChunk == 0 && u + kScanChunk <= w && nothing_in(row + u)) {
+          u += kScanChunk - 1;  // most of the image is outside the working volume
+          continue;
+        }
+        if (row[u] <= 0.0F) continue;
+        const Vector3d p = ray_point(u, r_v, row[u]);
+        if ((p - centre).squaredNorm() > hand_radius * hand_radius) continue;
+        out.hand_mask[static_cast<size_t>(v) * w + u] = 1;
+        near.add(u, v);
+        tip = std::max(tip, p.dot(axis));
+      }
+    }
+    const double cut = std::max(wrist.dot(axis) - kWristCutMarginMm, tip - kHandLengthMargin * config.hand_length_mm);
+    hand_box_ = PixelBox{w, h, -1, -1};
+    hand_sum_ = Vector3d::Zero();
+    int kept = 0;
+    for (int v = near.v0; v <= near.v1; ++v) {
+      const double r_v = ray_v(v);
+      for (int u = near.u0; u <= near.u1; ++u) {
+        const auto i = static_cast<size_t>(v) * w + u;
+        if (!out.hand_mask[i]) continue;
+        const Vector3d p = ray_point(u, r_v, d[i]);
+        if (p.dot(axis) < cut) {
+          out.hand_mask[i] = 0;
+          continue;
+        }
+        hand_box_.add(u, v);
+        hand_sum_ += p;
+        ++kept;
+      }
+    }
+    return kept;
+  };
+  const auto area_mm2 = [&](int pixels, double depth_mm) { return pixels * depth_mm * depth_mm / (cam.fx * cam.fy); };
+
+  int count = found ? select() : 0;
+  if (found && area_mm2(count, centre.z()) < config.min_hand_area_mm2) found = false;
+
+  if (!found) {
+    // No usable hint: the nearest sizeable surface in the working volume is the hand (and maybe
+    // its forearm). Label 4-connected surfaces whose neighbouring depths differ < continuity_mm.
+    component_.assign(n, -1);
+    struct Blob {
+      int pixels = 0;
+      double depth_sum = 0.0;
+    };
+    std::vector<Blob> blobs;
+    for (size_t seed = 0; seed < n; ++seed) {
+      if (d[seed] <= 0.0F || component_[seed] >= 0) continue;
+      const int id = static_cast<int>(blobs.size());
+      Blob blob;
+      stack_.clear();
+      stack_.push_back(static_cast<int>(seed));
+      component_[seed] = id;
+      while (!stack_.empty()) {
+        const auto i = static_cast<size_t>(stack_.back());
+        stack_.pop_back();
+        ++blob.pixels;
+        blob.depth_sum += d[i];
+        const int u = static_cast<int>(i % w);
+        const int v = static_cast<int>(i / w);
+        const auto visit = [&](int uu, int vv) {
+          if (uu < 0 || vv < 0 || uu >= w || vv >= h) return;
+          const auto j = static_cast<size_t>(vv) * w + uu;
+          if (component_[j] >= 0 || d[j] <= 0.0F || std::abs(d[j] - d[i]) >= config.continuity_mm) return;
+          component_[j] = id;
+          stack_.push_back(static_cast<int>(j));
+        };
+        visit(u - 1, v);
+        visit(u + 1, v);
+        visit(u, v - 1);
+        visit(u, v + 1);
+      }
+      blobs.push_back(blob);
+    }
+    int best = -1;
+    double best_depth = std::numeric_limits<double>::infinity();
+    for (size_t b = 0; b < blobs.size(); ++b) {
+      const double mean = blobs[b].depth_sum / blobs[b].pixels;
+      if (area_mm2(blobs[b].pixels, mean) < config.min_hand_area_mm2) continue;
+      if (mean < best_depth) {
+        best_depth = mean;
+        best = static_cast<int>(b);
+      }
+    }
+    if (best < 0) {
+      std::fill(out.hand_mask.begin(), out.hand_mask.end(), 0);
+      out.gaussians.clear();
+      return;
+    }
+    // Principal axis of the blob; the hand is the end that does not leave the image (the arm
+    // does), or, when neither or both do, the end nearer the camera.
+    Vector3d mean = Vector3d::Zero();
+    int pixels = 0;
+    for (size_t i = 0; i < n; ++i) {
+      if (component_[i] != best) continue;
+      mean += point(i);
+      ++pixels;
+    }
+    mean /= pixels;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (size_t i = 0; i < n; ++i) {
+      if (component_[i] != best) continue;
+      const Vector3d q = point(i) - mean;
+      cov += q * q.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    axis = eig.eigenvectors().col(2);
+    double lo = std::numeric_limits<double>::infinity();
+    double hi = -lo;
+    for (size_t i = 0; i < n; ++i) {
+      if (component_[i] != best) continue;
+      const double s = (point(i) - mean).dot(axis);
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    constexpr double kEndMm = 40.0;
+    struct End {
+      int border = 0;
+      int pixels = 0;
+      double depth = 0.0;
+    } top, bottom;
+    for (size_t i = 0; i < n; ++i) {
+      if (component_[i] != best) continue;
+      const double s = (point(i) - mean).dot(axis);
+      End* end = s > hi - kEndMm ? &top : s < lo + kEndMm ? &bottom : nullptr;
+      if (end == nullptr) continue;
+      const int u = static_cast<int>(i % w);
+      const int v = static_cast<int>(i / w);
+      end->border += (u < kBorderPx || v < kBorderPx || u >= w - kBorderPx || v >= h - kBorderPx) ? 1 : 0;
+      end->depth += d[i];
+      ++end->pixels;
+    }
+    const bool top_is_hand = top.border != bottom.border ? top.border < bottom.border
+                                                         : top.depth / std::max(1, top.pixels) <=
+                                                               bottom.depth / std::max(1, bottom.pixels);
+    if (!top_is_hand) {
+      axis = -axis;
+      std::swap(lo, hi);
+      lo = -lo;
+      hi = -hi;
+    }
+    // The palm centre is the hand pixel farthest from the hand's outline (the centre of the largest
+    // inscribed disc): the palm is the widest part of a hand, open or closed, and wider than the
+    // forearm. Search within one hand length of the tip.
+    const double length = config.hand_length_mm;
+    std::vector<int>& dist = stack_;
+    dist.assign(n, 0);
+    for (size_t i = 0; i < n; ++i) {
+      if (component_[i] == best && (point(i) - mean).dot(axis) >= hi - length) dist[i] = 1 << 20;
+    }
+    chamfer_distance(dist, w, h);
+    const auto centre_px = static_cast<size_t>(std::max_element(dist.begin(), dist.end()) - dist.begin());
+    centre = point(centre_px);
+    // The wrist sits about half a palm below the palm centre.
+    wrist = centre - axis * (kWristBelowPalmCentre * length);
+    count = select();
+    if (far_plane_cut_fraction(config, unclamped_mm, out, best) > kMaxFarPlaneCut) count = 0;
+  }
+  out.hand_pixels = count;
+  out.finger_axis = axis;
+  out.palm_centre_mm = centre;
+  out.hand_centroid_mm = count > 0 ? Vector3d(hand_sum_ / count) : centre;
+  if (area_mm2(count, out.hand_centroid_mm.z()) < config.min_hand_area_mm2) {
+    std::fill(out.hand_mask.begin(), out.hand_mask.end(), 0);
+    out.hand_pixels = 0;
+  }
+}
+
+double HandSegmenter::far_plane_cut_fraction(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
+                                             const DepthInput& out, int blob) const {
+  const int w = out.camera.width;
+  const int h = out.camera.height;
+  const auto far = static_cast<float>(config.far_mm);
+  const auto reach = static_cast<float>(config.far_mm + config.continuity_mm);
+  int boundary = 0;
+  int continued = 0;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      if (component_[static_cast<size_t>(v) * w + u] != blob) continue;
+      bool edge = false;
+      bool beyond = false;
+      for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+        const int uu = u + du;
+        const int vv = v + dv;
+        if (uu < 0 || vv < 0 || uu >= w || vv >= h) continue;
+        const auto j = static_cast<size_t>(vv) * w + uu;
+        if (component_[j] == blob) continue;
+        edge = true;
+        beyond = beyond || (unclamped_mm[j] > far && unclamped_mm[j] <= reach);
+      }
+      boundary += edge ? 1 : 0;
+      continued += beyond ? 1 : 0;
+    }
+  }
+  return boundary > 0 ? static_cast<double>(continued) / boundary : 0.0;
+}
+
+}  // namespace handtrack

@@ -1,0 +1,30 @@
+#pragma once
+// The median filter of the depth image "to remove flying pixels" (paper Sec. 4): the exact 3x3
+// median from sorted column triples (vectorised), any other radius by sorting each window.
+// Private to core (DepthInputBuilder); its scratch is reused from frame to frame.
+#include "handtrack/core/camera.hpp"
+
+#include <vector>
+
+namespace handtrack {
+
+class MedianFilter {
+ public:
+  // The median of each (2 radius + 1)^2 window of depth.depth_mm (borders repeat the edge pixel,
+  // non-finite samples count as 0); valid until the next call.
+  const std::vector<float>& apply(const DepthImage& depth, int radius);
+
+ private:
+  void median_3x3(const DepthImage& depth);
+  // Sorts the column triples (a[u], b[u], c[u]) of three rows into lo[u] <= mid[u] <= hi[u].
+  static void sort_columns(const float* __restrict a, const float* __restrict b, const float* __restrict c, int n,
+                           float* __restrict lo, float* __restrict mid, float* __restrict hi);
+  void median_any(const DepthImage& depth, int radius);
+
+  std::vector<float> out_;
+  std::vector<float> window_;         // median_any's window
+  std::vector<float> clean_;          // median_3x3's input, non-finite samples as 0
+  std::vector<float> lo_, mid_, hi_;  // median_3x3's sorted column triples
+};
+
+}  // namespace handtrack
