@@ -4,7 +4,7 @@
 // the synthetic camera, lets it warm up, and then requires the count not to move over 150 frames.
 //
 // The frames are rendered before the run and replayed (back and forth, so the motion stays
-// smooth): SyntheticCamera::render allocates in its motion keyframes (tools/synth), which is the
+// smooth): SyntheticCamera::render allocates in its motion keyframes (synth/), which is the
 // virtual camera's cost, not the pipeline's.
 #include "handtrack/daemon/pipeline.hpp"
 #include "source_frames.hpp"
