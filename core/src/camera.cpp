@@ -6,6 +6,13 @@
 
 namespace handtrack {
 
+namespace {
+// A recording played at its own rate waits 1/fps between frames: below 1 fps a "camera" is a
+// slide show (and 1e-6 fps waits for days); above 1000 no depth camera exists.
+constexpr double kMinFps = 1.0;
+constexpr double kMaxFps = 1000.0;
+}  // namespace
+
 std::string CameraIntrinsics::problem() const {
   std::ostringstream why;
   if (width < 8 || height < 8 || width > 8192 || height > 8192) {
@@ -16,8 +23,8 @@ std::string CameraIntrinsics::problem() const {
     why << "cx, cy must lie inside the image, got " << cx << ", " << cy;
   } else if (!(std::isfinite(depth_scale_mm) && depth_scale_mm > 0.0 && depth_scale_mm <= 100.0)) {
     why << "depth_scale_mm must be in (0, 100], got " << depth_scale_mm;
-  } else if (!(std::isfinite(fps) && fps > 0.0 && fps <= 1000.0)) {
-    why << "fps must be in (0, 1000], got " << fps;
+  } else if (!(std::isfinite(fps) && fps >= kMinFps && fps <= kMaxFps)) {
+    why << "fps must be in [" << kMinFps << ", " << kMaxFps << "], got " << fps;
   }
   return why.str();
 }

@@ -24,14 +24,29 @@ struct PngImage {
   PngImage& operator=(const PngImage&) = delete;
 };
 
-// Opens `path`, checks it is grayscale without alpha, returns the header.
-void begin_gray_read(const std::filesystem::path& path, PngImage& png) {
+std::string size_text(png_uint_32 width, png_uint_32 height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+// Opens `path`, checks it is grayscale without alpha and of the expected size (header only:
+// nothing is decoded or allocated for the pixels yet).
+void begin_gray_read(const std::filesystem::path& path, PngSize expected, PngImage& png) {
   if (!std::filesystem::exists(path)) fail(path, "no such file");
   if (png_image_begin_read_from_file(&png.image, path.c_str()) == 0) {
     fail(path, std::string("not a readable PNG (") + png.image.message + ")");
   }
   if ((png.image.format & PNG_FORMAT_FLAG_COLOR) != 0 || (png.image.format & PNG_FORMAT_FLAG_ALPHA) != 0) {
     fail(path, "expected a single-channel grayscale PNG");
+  }
+  const png_uint_32 w = png.image.width;
+  const png_uint_32 h = png.image.height;
+  if (expected.width > 0 && (w != static_cast<png_uint_32>(expected.width) ||
+                             h != static_cast<png_uint_32>(expected.height))) {
+    fail(path, "is " + size_text(w, h) + " but camera.json says " +
+                   size_text(static_cast<png_uint_32>(expected.width), static_cast<png_uint_32>(expected.height)));
+  }
+  if (w == 0 || h == 0 || w > static_cast<png_uint_32>(kMaxPngSide) || h > static_cast<png_uint_32>(kMaxPngSide)) {
+    fail(path, "claims " + size_text(w, h) + " pixels; at most " + std::to_string(kMaxPngSide) + " a side");
   }
 }
 
@@ -51,33 +66,26 @@ void write(const std::filesystem::path& path, int width, int height, png_uint_32
 
 }  // namespace
 
-Gray16Image read_png_gray16(const std::filesystem::path& path) {
+Gray16Image read_png_gray16(const std::filesystem::path& path, PngSize expected) {
   PngImage png;
-  begin_gray_read(path, png);
-  const bool sixteen = (png.image.format & PNG_FORMAT_FLAG_LINEAR) != 0;
+  begin_gray_read(path, expected, png);
+  if ((png.image.format & PNG_FORMAT_FLAG_LINEAR) == 0) {
+    fail(path, "8-bit PNG: depth frames must be 16-bit grayscale (raw sensor units, SPEC.md)");
+  }
   Gray16Image out{static_cast<int>(png.image.width), static_cast<int>(png.image.height), 1, {}};
   out.pixels.resize(static_cast<size_t>(png.image.width) * png.image.height);
-  if (sixteen) {
-    // A 16-bit file is read as PNG_FORMAT_LINEAR_Y: libpng treats 16-bit data as linear and
-    // hands the stored values back unchanged (checked against the raw file in tests).
-    png.image.format = PNG_FORMAT_LINEAR_Y;
-    if (png_image_finish_read(&png.image, nullptr, out.pixels.data(), 0, nullptr) == 0) {
-      fail(path, std::string("corrupt PNG data (") + png.image.message + ")");
-    }
-  } else {
-    std::vector<uint8_t> narrow(out.pixels.size());
-    png.image.format = PNG_FORMAT_GRAY;
-    if (png_image_finish_read(&png.image, nullptr, narrow.data(), 0, nullptr) == 0) {
-      fail(path, std::string("corrupt PNG data (") + png.image.message + ")");
-    }
-    for (size_t i = 0; i < narrow.size(); ++i) out.pixels[i] = narrow[i];
+  // A 16-bit file is read as PNG_FORMAT_LINEAR_Y: libpng treats 16-bit data as linear and hands
+  // the stored values back unchanged (checked against the raw file in tests).
+  png.image.format = PNG_FORMAT_LINEAR_Y;
+  if (png_image_finish_read(&png.image, nullptr, out.pixels.data(), 0, nullptr) == 0) {
+    fail(path, std::string("corrupt PNG data (") + png.image.message + ")");
   }
   return out;
 }
 
-Gray8Image read_png_gray8(const std::filesystem::path& path) {
+Gray8Image read_png_gray8(const std::filesystem::path& path, PngSize expected) {
   PngImage png;
-  begin_gray_read(path, png);
+  begin_gray_read(path, expected, png);
   if ((png.image.format & PNG_FORMAT_FLAG_LINEAR) != 0) fail(path, "expected an 8-bit PNG, found 16-bit");
   Gray8Image out{static_cast<int>(png.image.width), static_cast<int>(png.image.height), 1, {}};
   out.pixels.resize(static_cast<size_t>(png.image.width) * png.image.height);

@@ -141,7 +141,7 @@ void write_camera_json(const fs::path& file, const CameraIntrinsics& c) {
   out << j.dump(1) << "\n";
 }
 
-SequenceReader::SequenceReader(fs::path dir) : dir_(std::move(dir)) {
+SequenceReader::SequenceReader(fs::path dir, Annotations annotations) : dir_(std::move(dir)) {
   if (!fs::is_directory(dir_)) fail(dir_, "not a directory");
   camera_ = read_camera_json(dir_ / "camera.json");
   const fs::path depth_dir = dir_ / "depth";
@@ -153,10 +153,13 @@ SequenceReader::SequenceReader(fs::path dir) : dir_(std::move(dir)) {
     if (stem.empty() || !std::all_of(stem.begin(), stem.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) {
       continue;
     }
+    // Frame numbers are ints (SPEC.md: NNNNNN); a longer name is refused rather than wrapped.
+    if (stem.size() > 9) fail(entry.path(), "frame number " + stem + " is too large (at most 999999999)");
     frames_.push_back(std::stoi(stem));
   }
   std::sort(frames_.begin(), frames_.end());
   if (frames_.empty()) fail(depth_dir, "holds no NNNNNN.png frames");
+  if (annotations == Annotations::kIgnore) return;
 
   if (const auto gt = dir_ / "groundtruth.csv"; fs::exists(gt)) {
     read_csv(gt, 3 * kNumFingers, [&](int frame, const std::vector<std::optional<double>>& v) {
@@ -182,20 +185,14 @@ SequenceReader::SequenceReader(fs::path dir) : dir_(std::move(dir)) {
 
 DepthImage SequenceReader::depth(size_t i) const {
   const auto file = frame_file(dir_ / "depth", frames_.at(i));
-  const auto raw = read_png_gray16(file);
-  if (raw.width != camera_.width || raw.height != camera_.height) {
-    fail(file, "is " + std::to_string(raw.width) + "x" + std::to_string(raw.height) + " but camera.json says " +
-                   std::to_string(camera_.width) + "x" + std::to_string(camera_.height));
-  }
+  const auto raw = read_png_gray16(file, PngSize{camera_.width, camera_.height});
   return DepthImage::from_raw(camera_, raw.pixels);
 }
 
 std::optional<Gray8Image> SequenceReader::labels(size_t i) const {
   const auto file = frame_file(dir_ / "labels", frames_.at(i));
   if (!fs::exists(file)) return std::nullopt;
-  auto labels = read_png_gray8(file);
-  if (labels.width != camera_.width || labels.height != camera_.height) fail(file, "size differs from camera.json");
-  return labels;
+  return read_png_gray8(file, PngSize{camera_.width, camera_.height});
 }
 
 Fingertips SequenceReader::fingertips(size_t i) const {

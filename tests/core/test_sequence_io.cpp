@@ -3,6 +3,8 @@
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/sequence.hpp"
 
+#include "forged_png.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -138,6 +140,48 @@ TEST_F(SequenceIo, BadGroundTruthNamesTheLine) {
   expect_error([&] { SequenceReader r(dir_); }, "groundtruth.csv", "line 2");
   write_text(dir_ / "groundtruth.csv", "0,a,2,3,,,,,,,,,,,,\n");
   expect_error([&] { SequenceReader r(dir_); }, "groundtruth.csv", "'a' is not a number");
+}
+
+// Hostile files (issue 13): the checks happen on the header, before a pixel is decoded.
+TEST_F(SequenceIo, AHugeClaimedSizeIsRefusedFromTheHeader) {
+  const auto cam = write_small();
+  const auto bomb = dir_ / "depth" / "000001.png";
+  test::write_png_claiming(bomb, 60000, 60000);
+  const auto size = fs::file_size(bomb);
+  EXPECT_LT(size, 200U);
+  // Against camera.json (what every reader of a sequence does) and against the absolute cap.
+  const SequenceReader r(dir_);
+  expect_error([&] { (void)r.depth(1); }, "000001.png", "is 60000x60000 but camera.json says 32x24");
+  expect_error([&] { (void)read_png_gray16(bomb); }, "000001.png", "claims 60000x60000 pixels; at most 8192");
+  expect_error([&] { (void)read_png_gray8(bomb); }, "000001.png", "60000x60000");
+  (void)cam;
+}
+
+TEST_F(SequenceIo, EightBitDepthIsRefusedNotReadAsMillimetres) {
+  write_small();
+  write_png_gray8(dir_ / "depth" / "000001.png", Gray8Image{32, 24, 1, std::vector<uint8_t>(32 * 24, 200)});
+  const SequenceReader r(dir_);
+  expect_error([&] { (void)r.depth(1); }, "000001.png", "8-bit PNG: depth frames must be 16-bit");
+}
+
+TEST_F(SequenceIo, HugeFrameNumberAndSlideShowFpsAreClearErrors) {
+  write_small();
+  write_png_gray16(dir_ / "depth" / "99999999999.png", Gray16Image{32, 24, 1, std::vector<uint16_t>(32 * 24, 500)});
+  expect_error([&] { SequenceReader r(dir_); }, "99999999999.png", "frame number 99999999999 is too large");
+  fs::remove(dir_ / "depth" / "99999999999.png");
+  write_text(dir_ / "camera.json", R"({"width":32,"height":24,"fx":30,"fy":30,"cx":16,"cy":12,"fps":1e-6})");
+  expect_error([&] { SequenceReader r(dir_); }, "camera.json", "fps must be in [1, 1000]");
+}
+
+TEST_F(SequenceIo, APlayerIgnoresAnnotationsItNeverUses) {
+  write_small();
+  write_text(dir_ / "groundtruth.csv", "garbage,not,csv\n\x01\x02");
+  write_text(dir_ / "joints.csv", "0,a\n");
+  expect_error([&] { SequenceReader r(dir_); }, "groundtruth.csv", "line");
+  const SequenceReader player(dir_, SequenceReader::Annotations::kIgnore);
+  EXPECT_EQ(player.frame_count(), 2U);
+  EXPECT_FALSE(player.has_groundtruth());
+  EXPECT_EQ(player.depth(0).width(), 32);
 }
 
 TEST(RealData, Sr305FrameLoadsWithItsDepthUnit) {

@@ -6,6 +6,7 @@
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/sequence.hpp"
 #include "source_frames.hpp"
+#include "forged_png.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -408,6 +409,22 @@ TEST_F(Handtrackd, CorruptPngFramesAreSkippedAndCounted) {
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("bad frame skipped"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("000010.png"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("58 frames captured, 58 published"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("2 source errors"), std::string::npos) << r.err;
+}
+
+// Hostile sequence files (issue 13): a frame whose header claims 60000 x 60000 pixels (a 177-byte
+// memory bomb) and an 8-bit frame are skipped and counted with their reason, read from the header
+// without allocating; a garbage groundtruth.csv is not even opened (handtrackd never scores).
+TEST_F(Handtrackd, HostileSequenceFilesAreSkippedWithTheirReason) {
+  ShmName shm("hostile");
+  const auto seq = copy_of_pinch("hostile");
+  test::write_png_claiming(seq / "depth" / "000010.png", 60000, 60000);
+  write_png_gray8(seq / "depth" / "000020.png", Gray8Image{320, 240, 1, std::vector<uint8_t>(320 * 240, 200)});
+  std::ofstream(seq / "groundtruth.csv") << "\x01garbage,\n1,2\n";
+  const auto r = run(daemon_args({"--source", "seq:" + seq.string(), "--fast", "--shm-name", shm.str()}), dir_, "d", 60s);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("is 60000x60000 but camera.json says 320x240"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("58 frames captured, 58 published"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("2 source errors"), std::string::npos) << r.err;
 }

@@ -21,7 +21,7 @@ class SequenceSource final : public DepthSource {
 
   bool open(std::string* why) override {
     try {
-      reader_.emplace(dir_);
+      reader_.emplace(dir_, SequenceReader::Annotations::kIgnore);  // handtrackd never scores
     } catch (const std::exception& e) {
       if (why != nullptr) *why = e.what();
       return false;
@@ -49,14 +49,10 @@ class SequenceSource final : public DepthSource {
     const auto file = frame_file(reader_->dir() / "depth", number);
     frame.capture_ns = monotonic_ns();
     try {
-      image_ = read_png_gray16(file);
+      // The size is checked against camera.json from the header, before anything is allocated.
+      image_ = read_png_gray16(file, PngSize{camera.width, camera.height});
     } catch (const std::exception& e) {
       last_error_ = e.what();
-      return GrabStatus::kError;
-    }
-    if (image_.width != camera.width || image_.height != camera.height) {
-      last_error_ = file.string() + ": is " + std::to_string(image_.width) + "x" + std::to_string(image_.height) +
-                    " but camera.json says " + std::to_string(camera.width) + "x" + std::to_string(camera.height);
       return GrabStatus::kError;
     }
     frame.camera = camera;

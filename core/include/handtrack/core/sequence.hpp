@@ -25,7 +25,12 @@ void write_camera_json(const std::filesystem::path& file, const CameraIntrinsics
 
 class SequenceReader {
  public:
-  explicit SequenceReader(std::filesystem::path dir);
+  // What to read besides camera.json and the depth frames.
+  enum class Annotations {
+    kRead,    // groundtruth.csv and joints.csv too (evaluation, calibration)
+    kIgnore,  // neither is opened: a player of the depth (handtrackd's seq: source) never needs them
+  };
+  explicit SequenceReader(std::filesystem::path dir, Annotations annotations = Annotations::kRead);
 
   [[nodiscard]] const CameraIntrinsics& camera() const { return camera_; }
   [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
