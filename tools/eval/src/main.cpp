@@ -12,8 +12,8 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
-#include <cstdio>
 #include <filesystem>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -92,7 +92,9 @@ int main(int argc, char** argv) {
     for (const auto& d : dirs) {
       readers.emplace_back(d);
       if (!readers.back().has_groundtruth()) {
-        throw std::runtime_error(d + ": no groundtruth.csv, nothing to score");
+        const bool present = std::filesystem::exists(std::filesystem::path(d) / "groundtruth.csv");
+        throw std::runtime_error(d + (present ? "/groundtruth.csv: no annotated frame in it, nothing to score"
+                                              : ": no groundtruth.csv, nothing to score"));
       }
       if (oracle_labels && readers.back().frame_count() > 0 && !readers.back().labels(0)) {
         throw std::runtime_error(d + ": no labels/, needed by --oracle-labels");
@@ -117,6 +119,11 @@ int main(int argc, char** argv) {
       scores.push_back(scorer.finish(seconds));
     }
     const auto total = eval::overall(scores);
+    // A mean over no frame is not a result: every annotated frame got no pose (or a NaN one).
+    if (total.scored == 0) {
+      throw std::runtime_error("no frame could be scored: the tracker reported no hand in all " +
+                               std::to_string(total.frames) + " frames with ground truth");
+    }
     const auto json = eval::to_json(scores, total);
     if (!json_file.empty()) {
       std::ofstream out(json_file);
