@@ -540,5 +540,14 @@ TEST_F(Handtrackd, UnknownSourceIsAClearError) {
   expect_one_line_error(run(daemon_args({"--source", "synthetic:juggle"}), dir_, "d2"), {"juggle", "unknown motion"});
 }
 
+// A 10 MB string in the configuration (issue 13) is named in one line, not echoed whole.
+TEST_F(Handtrackd, AHugeConfigStringIsNotEchoedWhole) {
+  const auto config = dir_ / "huge.toml";
+  std::ofstream(config) << "[daemon]\nsource = \"" << std::string(10'000'000, 'x') << "\"\n";
+  const auto r = run(daemon_args({"--config", config.string()}), dir_, "d", 60s);
+  expect_one_line_error(r, {"huge.toml: daemon.source", "characters left out"});
+  EXPECT_LT(r.err.size(), 2000U);
+}
+
 }  // namespace
 }  // namespace handtrack::test

@@ -11,9 +11,20 @@
 
 namespace handtrack {
 
-// Writes "PROGRAM: error: MESSAGE" as one line (newlines folded) and returns `code`.
+// Longest message report_error() prints: a hostile input (a 10 MB string in a configuration
+// file) is named, not echoed.
+inline constexpr size_t kMaxErrorLine = 1000;
+
+// Writes "PROGRAM: error: MESSAGE" as one line (newlines folded) and returns `code`. A message
+// longer than kMaxErrorLine keeps its beginning (which file, which field) and its end (the reason)
+// and says how much was left out between them.
 inline int report_error(const std::string& program, const std::string& message, int code) {
   std::string line = message;
+  if (line.size() > kMaxErrorLine) {
+    const size_t keep = kMaxErrorLine / 2;
+    line = message.substr(0, keep) + " [... " + std::to_string(message.size() - 2 * keep) + " characters left out ...] " +
+           message.substr(message.size() - keep);
+  }
   for (auto& c : line) {
     if (c == '\n') c = ' ';
   }
