@@ -3,7 +3,7 @@
 // OpenNI::shutdown() when the last one lets go, and OpenNI2's device events (connected,
 // disconnected, state changed) turned into per-source "device lost" flags.
 //
-// @thread Runtime::acquire and the DeviceWatch registry are safe from any thread. OpenNI2 raises
+// Thread roles: thread-safe (Runtime::acquire and the DeviceWatch registry). OpenNI2 raises
 // device events on its drivers' own threads (USB event thread, a virtual driver's poll thread):
 // the listeners only take `watch_mutex_` and set atomics, never call back into OpenNI2, so they
 // cannot deadlock against a grab thread that is inside OpenNI2.

@@ -8,7 +8,7 @@
 //   for (int i = 0; i < 300; ++i) cam.render(i, f);  // f.depth, f.labels, f.joints, f.fingertips
 //
 // Frames are a pure function of (options, frame index): random access, deterministic.
-// @thread A SyntheticCamera is not thread-safe (render() reuses internal buffers); use one per thread.
+// Thread roles: reentrant (render() reuses internal buffers): one SyntheticCamera per thread.
 
 #include "handtrack/core/camera.hpp"
 #include "handtrack/core/png_io.hpp"

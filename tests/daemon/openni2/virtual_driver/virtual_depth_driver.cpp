@@ -15,7 +15,7 @@
 // callbacks. An unplugged device stops delivering frames but its objects stay valid until OpenNI2
 // closes them, and deviceOpen refuses while unplugged, as with a real sensor.
 //
-// @thread OpenNI2 calls the driver from the application's threads; the poll thread and one
+// Thread roles: OpenNI2 calls the driver from the application's threads; the poll thread and one
 // frame thread per started stream are the driver's own. `Driver::mutex_` guards the open-device
 // list; callbacks into OpenNI2 are never made while holding it (OpenNI2 takes its own locks and
 // calls back into the driver, so holding ours would risk a lock-order inversion).
