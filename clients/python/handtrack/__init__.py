@@ -162,7 +162,7 @@ def _error(status):
 
 
 class Client:
-    """A read-only connection to one shared-memory pose ring. Thread roles: reentrant (one Client per thread).
+    """A read-only connection to one shared-memory pose ring (thread roles: reentrant).
 
     Methods return a Pose, or None when nothing arrived in time. A dead or stopped daemon is
     reported through the `trouble` attribute (ERR_WRITER_DEAD / ERR_WRITER_STOPPED, else OK);
