@@ -180,18 +180,25 @@ TEST(Pipeline, LiveSourceFasterThanTheOptimizerDropsOldestFramesAndStaysFresh) {
   EXPECT_EQ(c.frames_published + c.frames_dropped + c.frames_skipped, c.frames_captured);
   ASSERT_EQ(records.size(), c.frames_published);
   std::vector<double> age_ms;
+  std::vector<double> work_ms;  // preprocess + optimize of each published frame
   for (size_t i = 0; i < records.size(); ++i) {
     if (i > 0) {
       EXPECT_GT(records[i].frame, records[i - 1].frame) << "published out of order";
     }
     age_ms.push_back(static_cast<double>(records[i].publish_ns - records[i].capture_ns) * 1e-6);
+    work_ms.push_back(static_cast<double>(records[i].preprocess_ms) + static_cast<double>(records[i].optimize_ms));
   }
   std::sort(age_ms.begin(), age_ms.end());
-  // Newest wins: a pose is at most a couple of frame times old, not a queue's worth.
+  std::sort(work_ms.begin(), work_ms.end());
+  // Newest wins: a pose is about two frames' work old (the optimizer finishes the frame it holds,
+  // then works on the newest), not a queue's worth (raw and input queues hold 4 frames each: a
+  // first-in-first-out pipeline would be 8 or more frames' work old). Measured in the pipeline's
+  // own work time, so that the bound holds on a slow machine and under ThreadSanitizer alike.
   const double p50 = age_ms[age_ms.size() / 2];
-  std::printf("live overload: %zu published, %llu dropped, age p50 %.1f ms, max %.1f ms\n", records.size(),
-              static_cast<unsigned long long>(c.frames_dropped), p50, age_ms.back());
-  EXPECT_LT(p50, 150.0);
+  const double work = work_ms[work_ms.size() / 2];
+  std::printf("live overload: %zu published, %llu dropped, age p50 %.1f ms, max %.1f ms, work p50 %.1f ms\n",
+              records.size(), static_cast<unsigned long long>(c.frames_dropped), p50, age_ms.back(), work);
+  EXPECT_LT(p50, 3.0 * work + 10.0);
 }
 
 }  // namespace
