@@ -14,6 +14,10 @@ namespace handtrack::daemon {
 
 class Doorbell {
  public:
+  // How long a waiting pipeline thread sleeps at most before it re-checks whether to stop (a
+  // stop rings every doorbell, so this only bounds a missed or absent ring).
+  static constexpr int64_t kIdleWaitNs = 50'000'000;
+
   // SYNC: acquire, pairs with ring()'s release increment: whatever the producer wrote before
   // ringing (the queue push) is visible to a consumer whose ticket shows the ring.
   [[nodiscard]] uint32_t ticket() const { return word_.load(std::memory_order_acquire); }

@@ -11,7 +11,6 @@ namespace handtrack::daemon {
 
 namespace {
 constexpr auto kGrabTimeout = std::chrono::milliseconds(100);  // a grab() returns at least this often
-constexpr int64_t kIdleWaitNs = 50'000'000;                    // waiting to reopen re-checks stop this often
 constexpr int64_t kReopenIntervalNs = 1'000'000'000;           // live device: open() retries
 }  // namespace
 
@@ -48,7 +47,7 @@ void GrabStage::close() {
 bool GrabStage::open_source() {
   const int64_t now = monotonic_ns();
   if (now < next_open_ns_) {
-    bell_.wait(bell_.ticket(), std::min<int64_t>(next_open_ns_ - now, kIdleWaitNs));
+    bell_.wait(bell_.ticket(), std::min<int64_t>(next_open_ns_ - now, Doorbell::kIdleWaitNs));
     return false;
   }
   watch_.busy(Stage::kGrab, next_seq_, now);

@@ -30,10 +30,6 @@
 
 namespace handtrack::daemon {
 
-namespace {
-constexpr int64_t kIdleWaitNs = 50'000'000;  // queue waits re-check stop this often
-}  // namespace
-
 struct Pipeline::Impl {
   Impl(const DaemonConfig& c, std::unique_ptr<DepthSource> s, ipc::PoseRingWriter& r)
       : config(c), source(std::move(s)), ring(r), lossless(c.fast && !source->is_live()),
@@ -127,7 +123,7 @@ struct Pipeline::Impl {
         const uint32_t ticket = grab_bell.ticket();
         f = acquire_free();
         if (f == nullptr) {
-          grab_bell.wait(ticket, kIdleWaitNs);
+          grab_bell.wait(ticket, Doorbell::kIdleWaitNs);
           continue;
         }
       }
@@ -148,7 +144,7 @@ struct Pipeline::Impl {
           break;
         }
         if (stopping()) break;
-        grab_bell.wait(ticket, kIdleWaitNs);
+        grab_bell.wait(ticket, Doorbell::kIdleWaitNs);
       }
     }
     // SYNC: release, pairs with the acquire loads in finished() and the recorder's done(): every
@@ -177,7 +173,7 @@ struct Pipeline::Impl {
         opt_bell.ring();
         worked = true;
       }
-      if (!worked) pre_bell.wait(ticket, kIdleWaitNs);
+      if (!worked) pre_bell.wait(ticket, Doorbell::kIdleWaitNs);
     }
   }
 
@@ -187,7 +183,7 @@ struct Pipeline::Impl {
       const uint32_t ticket = opt_bell.ticket();
       Frame* next = take_newest(*input_q, *free_from_opt);
       if (next == nullptr) {
-        opt_bell.wait(ticket, kIdleWaitNs);
+        opt_bell.wait(ticket, Doorbell::kIdleWaitNs);
         continue;
       }
       pre_bell.ring();  // room in input_q
@@ -209,7 +205,7 @@ struct Pipeline::Impl {
         tally.complete();
         grab_bell.ring();
       } else {
-        pub_bell.wait(ticket, kIdleWaitNs);
+        pub_bell.wait(ticket, Doorbell::kIdleWaitNs);
       }
       stats.maybe_publish(monotonic_ns());
     }

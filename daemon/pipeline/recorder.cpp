@@ -7,10 +7,6 @@
 
 namespace handtrack::daemon {
 
-namespace {
-constexpr int64_t kIdleWaitNs = 50'000'000;  // an idle recorder re-checks done() this often
-}  // namespace
-
 Recorder::Recorder(std::string dir, PipelineTally& tally) : dir_(std::move(dir)), tally_(tally) {
   for (size_t i = 0; i < kBuffers; ++i) {
     pool_.push_back(std::make_unique<Buffer>());
@@ -57,7 +53,7 @@ void Recorder::run(const std::function<bool()>& done) {
     Buffer* b = nullptr;
     if (!full_.pop(b)) {
       if (done()) break;  // drained
-      bell_.wait(ticket, kIdleWaitNs);
+      bell_.wait(ticket, Doorbell::kIdleWaitNs);
       continue;
     }
     try {

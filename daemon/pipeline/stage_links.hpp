@@ -46,7 +46,7 @@ class TrackerReload {
     // SYNC: release, pairs with generation()'s acquire: a stage that sees the new generation
     // takes the mutex after it and so reads the new configuration (the mutex alone orders the
     // configuration; the counter only saves the lock on the 99.99 % of frames without a reload).
-    generation_.fetch_add(1, std::memory_order_acq_rel);
+    generation_.fetch_add(1, std::memory_order_release);
   }
   // SYNC: acquire, pairs with post()'s increment.
   [[nodiscard]] uint64_t generation() const { return generation_.load(std::memory_order_acquire); }

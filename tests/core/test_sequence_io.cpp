@@ -187,7 +187,8 @@ TEST_F(SequenceIo, APlayerIgnoresAnnotationsItNeverUses) {
 TEST(RealData, Sr305FrameLoadsWithItsDepthUnit) {
   const fs::path file = fs::path(HANDTRACK_SHARED_DATA_DIR) / "real-sr305/20210326-230536/110.png";
   if (!fs::exists(file)) GTEST_SKIP() << "shared data absent: " << file;
-  CameraIntrinsics cam{640, 480, 476.007, 476.007, 313.683, 242.755, 0.125, 30};
+  CameraIntrinsics cam{Sr305Camera::kWidth, Sr305Camera::kHeight, Sr305Camera::kFx, Sr305Camera::kFy,
+                       Sr305Camera::kCx,    Sr305Camera::kCy,     Sr305Camera::kDepthScaleMm, 30};
   const auto raw = read_png_gray16(file);
   ASSERT_EQ(raw.width, 640);
   const DepthImage d = DepthImage::from_raw(cam, raw.pixels);
