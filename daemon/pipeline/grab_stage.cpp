@@ -71,6 +71,10 @@ bool GrabStage::open_source() {
 
 GrabStage::Step GrabStage::step(Frame& f) {
   if (config_.max_frames > 0 && next_seq_ >= static_cast<uint64_t>(config_.max_frames)) return Step::kDone;
+  if (failed_) {  // a recording whose source failed: idle (the heartbeat goes on) until stopped
+    bell_.wait(bell_.ticket(), Doorbell::kIdleWaitNs);
+    return Step::kNothing;
+  }
   if (!open_ && !open_source()) return Step::kNothing;
   watch_.busy(Stage::kGrab, next_seq_, monotonic_ns());
   const GrabStatus status = source_.grab(f.raw, kGrabTimeout);
@@ -99,6 +103,19 @@ GrabStage::Step GrabStage::step(Frame& f) {
       open_ = false;
       next_open_ns_ = now + kReopenIntervalNs / 2;
       set_device_state(ipc::DeviceState::kWaitingForDevice);
+      return Step::kNothing;
+    case GrabStatus::kFailed:
+      source_.close();
+      open_ = false;
+      set_device_state(ipc::DeviceState::kError);
+      if (source_.is_live()) {
+        next_open_ns_ = now + kReopenIntervalNs;
+        log().error("{}: {}; reopening it", source_.describe(), source_.last_error());
+      } else {
+        failed_ = true;
+        log().error("{}: {}; no more frames from it (state error until handtrackd stops)", source_.describe(),
+                    source_.last_error());
+      }
       return Step::kNothing;
     case GrabStatus::kError: {
       const auto errors = tally_.source_errors.fetch_add(1, std::memory_order_relaxed) + 1;

@@ -52,6 +52,7 @@ class GrabStage {
   Doorbell& bell_;  // rung when a frame comes free; wakes a grab thread waiting to reopen
   Recorder* recorder_;
   bool open_ = false;
+  bool failed_ = false;  // a recording's source failed (GrabStatus::kFailed): no more frames
   uint64_t next_seq_ = 0;
   int64_t next_open_ns_ = 0;
   std::string last_open_problem_;

@@ -18,6 +18,11 @@ std::unique_ptr<DepthSource> make_oni_recording(const std::string& file, const S
 // camera.json's size is reported as GrabStatus::kError (skipped and counted) with the reason in
 // last_error().
 std::unique_ptr<DepthSource> make_sequence_source(const std::string& dir, const SourceOptions& options);
+// isolated/: an OpenNI2 source (openni2, openni2:URI, oni:FILE) run by handtrack-source-helper in
+// a child process; a fault in OpenNI2 or a driver ends the helper, grab() returns kFailed.
+std::unique_ptr<DepthSource> make_isolated_source(const std::string& spec, const SourceOptions& options);
+// The OpenNI2 sources in this process: what the helper runs (isolated/source_helper.cpp).
+std::unique_ptr<DepthSource> make_driver_source(const std::string& spec, const SourceOptions& options);
 // synthetic/: `motion` empty: cycle through all seven. Unknown motion: std::invalid_argument.
 std::unique_ptr<DepthSource> make_synthetic_source(const std::string& motion, const SourceOptions& options);
 

@@ -166,6 +166,10 @@ int handtrack::daemon::run_handtrackd(int argc, char** argv, const SourceFactory
   } catch (const std::exception& e) {
     return fail(e.what());
   }
+  if (!ring->removed_foreign_owner().empty()) {
+    log().warn("removed /{} of {}: an object of another user under our name is never written to or trusted",
+               config.shm_name, ring->removed_foreign_owner());
+  }
   if (ring->replaced_epoch()) log().info("replaced a stale ring /{} (epoch {})", config.shm_name, *ring->replaced_epoch());
   ring->set_device_state(ipc::DeviceState::kStarting);
 

@@ -103,6 +103,7 @@ const char* handtrack_strerror(int status) {
     case HANDTRACK_ERR_WRITER_STOPPED: return "the daemon has stopped";
     case HANDTRACK_ERR_BUSY: return "the record was overwritten during every read attempt";
     case HANDTRACK_ERR_SYSTEM: return "system error (see handtrack_error_detail)";
+    case HANDTRACK_ERR_UNTRUSTED_OWNER: return "the shared memory belongs to an untrusted user or others may write it (see handtrack_error_detail)";
     default: return "unknown handtrack status";
   }
 }

@@ -1,6 +1,7 @@
 // PoseRingReader: maps a segment read-only, reads records with the seqlock, waits on the futex.
 #include <handtrack/ipc/pose_ring_reader.hpp>
 
+#include "segment_owner.hpp"
 #include "seqlock.hpp"
 
 #include <boost/interprocess/mapped_region.hpp>
@@ -55,6 +56,12 @@ Status PoseRingReader::map(const std::string& name, bool initial) {
         status = HANDTRACK_ERR_SYSTEM;
         detail = "cannot open '/" + name + "': " + e.what();
       }
+      break;
+    }
+    if (const std::string why = detail::untrusted_reason(object.get_mapping_handle().handle, *trusted_);
+        !why.empty()) {
+      status = HANDTRACK_ERR_UNTRUSTED_OWNER;
+      detail = "'/" + name + "' refused: " + why;
       break;
     }
     bip::offset_t size = 0;
@@ -112,6 +119,12 @@ Status PoseRingReader::open(const std::string& name) {
   missed_ = missed_total_ = 0;
   if (name.empty() || name.find('/') != std::string::npos) {
     detail_ = "invalid shared memory name '" + name + "'";
+    return HANDTRACK_ERR_INVALID_ARGUMENT;
+  }
+  std::string trust_error;
+  trusted_ = std::make_unique<const detail::TrustedOwners>(detail::TrustedOwners::from_environment(&trust_error));
+  if (!trust_error.empty()) {
+    detail_ = trust_error;
     return HANDTRACK_ERR_INVALID_ARGUMENT;
   }
   return map(name, true);

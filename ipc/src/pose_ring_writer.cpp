@@ -1,6 +1,7 @@
 // PoseRingWriter: creates the segment, owns the name, publishes records.
 #include <handtrack/ipc/pose_ring_writer.hpp>
 
+#include "segment_owner.hpp"
 #include "seqlock.hpp"
 
 #include <boost/interprocess/mapped_region.hpp>
@@ -34,6 +35,7 @@ namespace {
 // What we learn from a segment already bearing the name.
 struct Previous {
   bool exists = false;
+  std::optional<uid_t> foreign_owner;  // owned by another user: never mapped, never written
   bool valid = false;       // a handtrack segment of our ABI
   bool live = false;        // its writer looks alive
   std::uint64_t epoch = 0;
@@ -48,6 +50,22 @@ bool pid_exists(std::int32_t pid) {
 
 Previous inspect_previous(const std::string& name) {
   Previous prev;
+  try {
+    const bip::shared_memory_object peek(bip::open_only, name.c_str(), bip::read_only);
+    uid_t owner = 0;
+    if (detail::owner_of(peek.get_mapping_handle().handle, &owner) && owner != ::geteuid()) {
+      prev.exists = true;
+      prev.foreign_owner = owner;
+      return prev;
+    }
+  } catch (const bip::interprocess_exception& e) {
+    if (e.get_native_error() == ENOENT) return prev;
+    // Not even readable: another user's (mode 0600, say). glibc keeps the names in /dev/shm.
+    prev.exists = true;
+    struct stat st {};
+    if (::stat(("/dev/shm/" + name).c_str(), &st) == 0 && st.st_uid != ::geteuid()) prev.foreign_owner = st.st_uid;
+    return prev;
+  }
   std::unique_ptr<bip::shared_memory_object> object;
   try {
     object = std::make_unique<bip::shared_memory_object>(bip::open_only, name.c_str(),
@@ -103,6 +121,7 @@ PoseRingWriter::PoseRingWriter(const Options& options)
     fail(name_, "heartbeat period " + std::to_string(period_ns) + " ns outside 1 ms..1 h");
   }
   if ((options.mode & ~0777U) != 0) fail(name_, "mode must be a permission mask like 0640");
+  if ((options.mode & 022U) != 0) fail(name_, "mode must not let other users write (readers refuse such a segment)");
 
   Previous prev = inspect_previous(name_);
   if (prev.live && !options.replace_live_writer) {
@@ -110,8 +129,16 @@ PoseRingWriter::PoseRingWriter(const Options& options)
                     std::to_string(prev.epoch) + ")");
   }
   if (prev.exists && ::shm_unlink(("/" + name_).c_str()) != 0 && errno != ENOENT) {
-    fail(name_, std::string("cannot remove the stale segment: ") + std::strerror(errno));
+    const int err = errno;
+    if (err == EPERM || err == EACCES) {
+      const std::string who = prev.foreign_owner ? detail::describe_user(*prev.foreign_owner) : "another user";
+      fail(name_, "the name is taken by an object of " + who +
+                      " that this user may not remove; remove it as root (rm /dev/shm/" + name_ +
+                      ") or choose another name");
+    }
+    fail(name_, std::string("cannot remove the stale segment: ") + std::strerror(err));
   }
+  if (prev.foreign_owner) removed_foreign_owner_ = detail::describe_user(*prev.foreign_owner);
   if (prev.valid) replaced_epoch_ = prev.epoch;
 
   const std::uint64_t total = shm::segment_size(capacity_);

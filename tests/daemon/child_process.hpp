@@ -2,6 +2,7 @@
 // Running the real programs (handtrackd, handtrack-cat, handtrack-synth) as child processes from
 // a test: output to files, extra environment, waits with timeouts, and no child left behind.
 #include <fcntl.h>
+#include <grp.h>
 #include <signal.h>
 #include <sys/mman.h>
 #include <sys/wait.h>
@@ -72,13 +73,20 @@ class ShmName {
   std::string name_;
 };
 
+// A user and group for a child to run as (the parent must be root).
+struct Identity {
+  uid_t uid = 0;
+  gid_t gid = 0;
+};
+
 class Child {
  public:
   Child(const std::vector<std::string>& argv, const fs::path& out, const fs::path& err,
-        const std::vector<std::string>& env = {})
+        const std::vector<std::string>& env = {}, std::optional<Identity> as = std::nullopt)
       : out_(out), err_(err) {
     pid_ = fork();
     if (pid_ == 0) {
+      if (as && (setgroups(0, nullptr) != 0 || setgid(as->gid) != 0 || setuid(as->uid) != 0)) _exit(126);
       const int o = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       const int e = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       if (o >= 0) dup2(o, STDOUT_FILENO);

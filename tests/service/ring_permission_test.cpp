@@ -4,6 +4,9 @@
 // outside the group is refused with HANDTRACK_ERR_PERMISSION. The real handtrackd runs as a
 // separate uid/gid (set in a forked child as root), so this is the mode and ownership the daemon
 // itself gives the segment, not one the test set. Skips when not root.
+#include "../daemon/child_process.hpp"
+#include "other_user.hpp"
+
 #include <handtrack/client.h>
 
 #include <gtest/gtest.h>
@@ -17,7 +20,6 @@
 
 #include <chrono>
 #include <cstdlib>
-#include <filesystem>
 #include <cstdio>
 #include <string>
 #include <thread>
@@ -57,37 +59,6 @@ int read_as(const std::string& name, const std::vector<gid_t>& supplementary) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-// What the daemon's user runs, copied to a fresh directory under /tmp that every user may enter:
-// the checkout (and so the build tree) may sit in a directory the service user cannot reach
-// (root's home, any mode-0700 directory), and exec() of a binary there fails for it.
-class ReachableCopy {
- public:
-  ReachableCopy() {
-    char pattern[] = "/tmp/handtrack-svc-XXXXXX";
-    if (::mkdtemp(pattern) == nullptr) return;
-    dir_ = pattern;
-    std::error_code ec;
-    std::filesystem::permissions(dir_, std::filesystem::perms(0755), ec);
-    std::filesystem::copy_file(HANDTRACKD, dir_ / "handtrackd", ec);
-    if (!ec) std::filesystem::copy_file(std::string(HANDTRACK_SOURCE_DIR) + "/data/handtrackd.toml",
-                                        dir_ / "handtrackd.toml", ec);
-    ok_ = !ec;
-  }
-  ~ReachableCopy() {
-    std::error_code ec;
-    if (!dir_.empty()) std::filesystem::remove_all(dir_, ec);
-  }
-  ReachableCopy(const ReachableCopy&) = delete;
-  ReachableCopy& operator=(const ReachableCopy&) = delete;
-  [[nodiscard]] bool ok() const { return ok_; }
-  [[nodiscard]] std::string daemon() const { return (dir_ / "handtrackd").string(); }
-  [[nodiscard]] std::string config() const { return (dir_ / "handtrackd.toml").string(); }
-
- private:
-  std::filesystem::path dir_;
-  bool ok_ = false;
-};
-
 }  // namespace
 
 TEST(ServiceRing, GroupMembersReadPosesOthersAreRefused) {
@@ -95,21 +66,16 @@ TEST(ServiceRing, GroupMembersReadPosesOthersAreRefused) {
   const std::string name = "htsvc_perm_" + std::to_string(::getpid());
   const std::string path = "/dev/shm/" + name;
   ::unlink(path.c_str());
-  const ReachableCopy copy;
+  const handtrack::test::ReachableCopy copy;
   ASSERT_TRUE(copy.ok()) << "cannot copy handtrackd and its configuration to /tmp";
+  // kDaemonUid stands for the service user "handtrack", which readers (root here) trust by name.
+  ::setenv("HANDTRACK_TRUSTED_USERS", std::to_string(kDaemonUid).c_str(), 1);
 
-  const pid_t daemon = ::fork();
-  if (daemon == 0) {
-    if (::setgroups(0, nullptr) != 0 || ::setgid(kDaemonGid) != 0 || ::setuid(kDaemonUid) != 0) ::_exit(90);
-    const int devnull = ::open("/dev/null", O_WRONLY);
-    ::dup2(devnull, STDOUT_FILENO);
-    const std::string exe = copy.daemon();
-    const std::string config = copy.config();
-    ::execl(exe.c_str(), exe.c_str(), "--config", config.c_str(), "--source", "synthetic:pinch",
-            "--shm-name", name.c_str(), "--log-level", "warn", static_cast<char*>(nullptr));
-    ::_exit(91);
-  }
-  ASSERT_GT(daemon, 0);
+  const handtrack::test::TempDir logs("perm");
+  ::chmod(logs.path().c_str(), 0777);
+  handtrack::test::Child daemon({copy.daemon(), "--config", copy.config(), "--source", "synthetic:pinch",
+                                 "--shm-name", name, "--log-level", "warn"},
+                                logs / "out", logs / "err", {}, handtrack::test::Identity{kDaemonUid, kDaemonGid});
 
   // Wait (as root) until the daemon publishes.
   bool publishing = false;
@@ -121,8 +87,7 @@ TEST(ServiceRing, GroupMembersReadPosesOthersAreRefused) {
       handtrack_close(client);
     }
     if (!publishing) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    int status = 0;
-    if (::waitpid(daemon, &status, WNOHANG) == daemon) FAIL() << "handtrackd exited with status " << status;
+    ASSERT_FALSE(daemon.wait(std::chrono::milliseconds(0))) << "handtrackd exited:\n" << daemon.err();
   }
   ASSERT_TRUE(publishing) << "handtrackd (uid " << kDaemonUid << ") did not publish within 15 s";
 
@@ -136,10 +101,8 @@ TEST(ServiceRing, GroupMembersReadPosesOthersAreRefused) {
   EXPECT_EQ(read_as(name, {}), kRefused) << "a process outside the group is refused";
   EXPECT_EQ(read_as(name, {kReaderGid + 1}), kRefused) << "other supplementary groups do not help";
 
-  ::kill(daemon, SIGTERM);
-  int status = 0;
-  ASSERT_EQ(::waitpid(daemon, &status, 0), daemon);
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "status " << status;
+  daemon.signal(SIGTERM);
+  EXPECT_EQ(daemon.wait(std::chrono::seconds(10)), 0) << daemon.err();
   // The stopped daemon leaves its segment (state "stopped"); the test cleans up its own.
   EXPECT_EQ(::access(path.c_str(), F_OK), 0);
   ::unlink(path.c_str());

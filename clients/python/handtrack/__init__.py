@@ -19,7 +19,8 @@ import ctypes.util
 import os
 
 __all__ = ["Client", "Pose", "Stats", "WriterStatus", "HandtrackError", "ABI_VERSION",
-           "TIMEOUT", "NO_RECORD", "ERR_WRITER_DEAD", "ERR_WRITER_STOPPED"]
+           "TIMEOUT", "NO_RECORD", "ERR_WRITER_DEAD", "ERR_WRITER_STOPPED",
+           "ERR_UNTRUSTED_OWNER"]
 
 ABI_VERSION = 1
 NUM_PARAMS = 26
@@ -31,6 +32,7 @@ TIMEOUT = 1
 NO_RECORD = 2
 ERR_WRITER_DEAD = -11
 ERR_WRITER_STOPPED = -12
+ERR_UNTRUSTED_OWNER = -15  # the segment's owner is not trusted (HANDTRACK_TRUSTED_USERS)
 
 _Vec3 = ctypes.c_float * 3
 

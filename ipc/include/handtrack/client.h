@@ -69,7 +69,8 @@ typedef enum handtrack_status {
   HANDTRACK_ERR_WRITER_DEAD = -11,   /* heartbeat stale: the daemon died or hangs */
   HANDTRACK_ERR_WRITER_STOPPED = -12, /* the daemon stopped cleanly */
   HANDTRACK_ERR_BUSY = -13,          /* the writer overwrote the slot during every read attempt */
-  HANDTRACK_ERR_SYSTEM = -14         /* an unexpected system call failure (see handtrack_error_detail) */
+  HANDTRACK_ERR_SYSTEM = -14,        /* an unexpected system call failure (see handtrack_error_detail) */
+  HANDTRACK_ERR_UNTRUSTED_OWNER = -15 /* the segment's owner is not trusted, or others may write it */
 } handtrack_status;
 
 typedef enum handtrack_tracking_state {
@@ -161,7 +162,11 @@ _Static_assert(sizeof(handtrack_writer_status) == 120, "handtrack_writer_status 
 typedef struct handtrack_client handtrack_client; /* opaque */
 
 /* Opens (maps read-only) the segment `shm_name` (NULL: "handtrack"). On success *out is a client
- * that must be closed with handtrack_close. Waiting for records starts after the newest record
+ * that must be closed with handtrack_close. Only a segment owned by a trusted user (root, this
+ * process's effective user, the service user "handtrack", and the users named in the environment
+ * variable HANDTRACK_TRUSTED_USERS: comma-separated names or uids) and writable by its owner alone
+ * is accepted; any other gives HANDTRACK_ERR_UNTRUSTED_OWNER, and handtrack_error_detail names the
+ * owner. The same check applies when a waiting call reattaches to a new segment of that name. Waiting for records starts after the newest record
  * present at open time. On failure *out is NULL and the status says why. */
 HANDTRACK_API int handtrack_open(const char* shm_name, handtrack_client** out);
 HANDTRACK_API void handtrack_close(handtrack_client* client);

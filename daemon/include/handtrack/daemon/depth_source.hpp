@@ -2,6 +2,8 @@
 // Where handtrackd's depth frames come from: one interface in front of every camera, recording
 // and virtual camera (like libcamera's PipelineHandler). SPEC.md "Sources":
 //   openni2 | openni2:URI | oni:FILE.oni | seq:DIR | synthetic[:MOTION]
+// The OpenNI2 sources run in a helper process (handtrack-source-helper): a driver fault ends
+// the helper, not the daemon.
 //
 // Thread roles: a DepthSource is driven by one thread, the pipeline's grab thread.
 // Error policy: open() reports why it failed in its return value; grab() returns a status and
@@ -33,6 +35,8 @@ enum class GrabStatus {
   kEndOfStream,   // a recording played to its end (and does not loop)
   kDisconnected,  // the device went away: close() and open() again later
   kError,         // a bad frame or read error: skipped and counted; streaming continues
+  kFailed,        // the source cannot go on (its driver process died or hung): state "error";
+                  // a live camera is reopened later, a recording stays failed
 };
 
 struct SourceOptions {
@@ -69,7 +73,7 @@ class DepthSource {
   [[nodiscard]] virtual CameraIntrinsics camera() const = 0;
   // True for cameras (retry open and reopen on loss), false for recordings and the virtual camera.
   [[nodiscard]] virtual bool is_live() const = 0;
-  // Why the last grab() returned kError or kDisconnected, for the log (empty: no details).
+  // Why the last grab() returned kError, kDisconnected or kFailed, for the log (empty: no details).
   // Added for the pipeline's "skipped and counted" log line; a default so sources may ignore it.
   [[nodiscard]] virtual std::string last_error() const { return {}; }
 };

@@ -1,7 +1,10 @@
 // handtrack/ipc/pose_ring_reader.hpp: a client's side of the shared-memory pose ring.
 //
 // Maps the segment read-only (the shm object may be mode 0640 and owned by another user) and
-// never writes to it, so it can neither block nor corrupt the writer. Errors are status values
+// never writes to it, so it can neither block nor corrupt the writer. It accepts a segment only
+// from a trusted owner (root, its own user, the service user "handtrack", and the users in
+// $HANDTRACK_TRUSTED_USERS) that no other user may write: anyone can create a name in /dev/shm
+// (docs/SECURITY.md). Errors are status values
 // (handtrack_status); nothing here throws except std::bad_alloc from open()'s strings.
 //
 // Thread role: one PoseRingReader is used by one thread at a time.
@@ -22,6 +25,10 @@
 
 namespace handtrack::ipc {
 
+namespace detail {
+class TrustedOwners;
+}  // namespace detail
+
 class PoseRingReader {
  public:
   PoseRingReader();
@@ -29,7 +36,7 @@ class PoseRingReader {
   PoseRingReader(PoseRingReader&&) noexcept;
   PoseRingReader& operator=(PoseRingReader&&) noexcept;
 
-  // Maps `name` read-only and validates its header. On error the reader stays closed and
+  // Maps `name` read-only, checks its owner and validates its header. On error the reader stays closed and
   // error_detail() says what did not match. Waiting starts after the newest record present now.
   Status open(const std::string& name);
   void close() noexcept;
@@ -66,6 +73,7 @@ class PoseRingReader {
 
   struct Mapping;
   std::unique_ptr<Mapping> mapping_;
+  std::unique_ptr<const detail::TrustedOwners> trusted_;  // read at open(), kept for reattaching
   const shm::Header* header_ = nullptr;
   const shm::Slot* slots_ = nullptr;
   std::uint32_t capacity_ = 0;

@@ -34,7 +34,7 @@ class PoseRingWriter {
     std::string name = kDefaultShmName;  // shm_open name, without the leading '/'
     std::uint32_t capacity = 256;        // records in the ring (>= 2); ~4 s at 60 fps
     std::chrono::nanoseconds heartbeat_period = std::chrono::milliseconds(100);
-    unsigned mode = 0640;                // file mode: group members may read (service issue)
+    unsigned mode = 0640;                // file mode: group members may read; never group/other write
     // Take the name over even when another writer's heartbeat is fresh and its pid exists.
     bool replace_live_writer = false;
     // Tests only: called inside publish() between the two sequence stores of a slot (the slot
@@ -43,7 +43,8 @@ class PoseRingWriter {
   };
 
   // Creates the segment `options.name`: replaces a stale one (its writer is dead or stopped, or
-  // it is not a valid handtrack segment), reserves all its memory (posix_fallocate: a full
+  // it is not a valid handtrack segment) and removes one of another user without ever mapping it
+  // (that fails, naming the owner, when this user may not remove it: /dev/shm is sticky), reserves all its memory (posix_fallocate: a full
   // /dev/shm fails here, not with SIGBUS later), sets the mode, picks an epoch greater than the
   // replaced segment's and not smaller than the wall clock in microseconds, and marks the old
   // segment superseded so its readers reattach at once. Throws std::runtime_error naming the
@@ -70,6 +71,8 @@ class PoseRingWriter {
   [[nodiscard]] std::chrono::nanoseconds heartbeat_period() const noexcept { return heartbeat_period_; }
   // The epoch of the valid segment this writer replaced, if there was one (for the daemon's log).
   [[nodiscard]] std::optional<std::uint64_t> replaced_epoch() const noexcept { return replaced_epoch_; }
+  // Who owned the object of another user that this writer removed from its name (empty: none).
+  [[nodiscard]] const std::string& removed_foreign_owner() const noexcept { return removed_foreign_owner_; }
 
   // Removes the name (shm_unlink); mapped readers keep their mapping. True if it existed.
   static bool remove(const std::string& name) noexcept;
@@ -86,6 +89,7 @@ class PoseRingWriter {
   std::uint64_t stats_version_ = 0;  // stats seqlock count; only set_stats()'s thread touches it
   std::chrono::nanoseconds heartbeat_period_{};
   std::optional<std::uint64_t> replaced_epoch_;
+  std::string removed_foreign_owner_;
   void (*test_hook_mid_publish_)(std::uint64_t) = nullptr;
 };
 
