@@ -95,6 +95,7 @@ class IsolatedSource final : public DepthSource {
       if (why != nullptr) *why = reason;
       return false;
     }
+    last_error_.clear();
     return true;
   }
 
@@ -174,31 +175,31 @@ class IsolatedSource final : public DepthSource {
     const OpenRequest request{options_.loop ? 1 : 0, options_.as_fast_as_possible ? 1 : 0, options_.width,
                               options_.height, options_.fps, 0};
     if (channel_.send(Kind::kOpen, &request, sizeof request, spec_.data(), spec_.size()) != Io::kOk) {
-      *why = helper_ended("opening");
+      *why = name_ + ": " + helper_ended("opening");
       return false;
     }
     const std::int64_t deadline = monotonic_ns() + kOpenDeadlineNs;
     Header header;
     const Io io = channel_.receive_header(&header, deadline);
     if (io == Io::kTimeout) {
-      *why = hung("opening");
+      *why = name_ + ": " + hung("opening");
     } else if (io != Io::kOk) {
-      *why = helper_ended("opening");
+      *why = name_ + ": " + helper_ended("opening");
     } else if (static_cast<Kind>(header.kind) == Kind::kStatus) {
       StatusReply reply;
       std::string text;
       if (header.payload_bytes < sizeof reply || channel_.receive(&reply, sizeof reply, deadline) != Io::kOk ||
           channel_.receive_text(&text, header.payload_bytes - sizeof reply, deadline) != Io::kOk) {
-        *why = broke_protocol("an answer to open");
+        *why = name_ + ": " + broke_protocol("an answer to open");
       } else {
         *why = text;  // the source's own reason, already naming it
       }
     } else if (static_cast<Kind>(header.kind) != Kind::kOpened || header.payload_bytes != sizeof(CameraReply)) {
-      *why = broke_protocol("an answer to open");
+      *why = name_ + ": " + broke_protocol("an answer to open");
     } else {
       CameraReply reply;
       if (channel_.receive(&reply, sizeof reply, deadline) != Io::kOk) {
-        *why = helper_ended("opening");
+        *why = name_ + ": " + helper_ended("opening");
         return false;
       }
       camera_ = CameraIntrinsics{reply.width, reply.height, reply.fx, reply.fy, reply.cx, reply.cy,
@@ -268,25 +269,27 @@ class IsolatedSource final : public DepthSource {
     return done == pid ? describe_exit(status) : "could not be waited for";
   }
 
+  // The messages below say what became of the helper, without the source's name: grab()'s
+  // last_error() is logged after describe(), and open() adds the name itself.
   // The socket closed or failed: the helper died (or is dying). Its exit, for the message.
   std::string helper_ended(const char* doing) {
     const pid_t pid = pid_;
     const std::string how = pid > 0 ? reap(200'000'000) : "was not running";
-    return name_ + ": the source helper (pid " + std::to_string(pid) + ") " + how + " while " + doing +
+    return "the source helper (pid " + std::to_string(pid) + ") " + how + " while " + doing +
            " (a driver fault, or a corrupt recording)";
   }
 
   std::string hung(const char* doing) {
     const pid_t pid = pid_;
     reap(0);
-    return name_ + ": the source helper (pid " + std::to_string(pid) + ") stopped answering while " + doing +
+    return "the source helper (pid " + std::to_string(pid) + ") stopped answering while " + doing +
            " and was killed (a hung driver)";
   }
 
   std::string broke_protocol(const char* expected) {
     const pid_t pid = pid_;
     reap(0);
-    return name_ + ": the source helper (pid " + std::to_string(pid) + ") sent something other than " + expected +
+    return "the source helper (pid " + std::to_string(pid) + ") sent something other than " + expected +
            " and was killed";
   }
 
