@@ -56,6 +56,9 @@ std::optional<double> parse_cell(const std::string& cell, const fs::path& file, 
   return v;
 }
 
+// Frame numbers are ints written as NNNNNN (SPEC.md); the largest a file name or CSV row may hold.
+constexpr int kMaxFrameNumber = 999'999'999;
+
 // Reads a CSV whose rows are: frame, then `values` numbers (possibly empty). Calls row(frame, cells).
 template <typename RowFn>
 void read_csv(const fs::path& file, size_t values, RowFn&& row) {
@@ -73,7 +76,10 @@ void read_csv(const fs::path& file, size_t values, RowFn&& row) {
                      std::to_string(cells.size()));
     }
     const auto frame = parse_cell(cells[0], file, n);
-    if (!frame || *frame < 0 || *frame != std::floor(*frame)) fail(file, "line " + std::to_string(n) + ": bad frame");
+    if (!frame || *frame < 0 || *frame > kMaxFrameNumber || *frame != std::floor(*frame)) {
+      fail(file, "line " + std::to_string(n) + ": bad frame (a whole number in [0, " +
+                     std::to_string(kMaxFrameNumber) + "])");
+    }
     std::vector<std::optional<double>> parsed;
     for (size_t i = 1; i < cells.size(); ++i) parsed.push_back(parse_cell(cells[i], file, n));
     row(static_cast<int>(*frame), parsed);
@@ -153,8 +159,10 @@ SequenceReader::SequenceReader(fs::path dir, Annotations annotations) : dir_(std
     if (stem.empty() || !std::all_of(stem.begin(), stem.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) {
       continue;
     }
-    // Frame numbers are ints (SPEC.md: NNNNNN); a longer name is refused rather than wrapped.
-    if (stem.size() > 9) fail(entry.path(), "frame number " + stem + " is too large (at most 999999999)");
+    // A longer name is refused rather than wrapped.
+    if (stem.size() > 9) {
+      fail(entry.path(), "frame number " + stem + " is too large (at most " + std::to_string(kMaxFrameNumber) + ")");
+    }
     frames_.push_back(std::stoi(stem));
   }
   std::sort(frames_.begin(), frames_.end());

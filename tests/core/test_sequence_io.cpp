@@ -140,6 +140,9 @@ TEST_F(SequenceIo, BadGroundTruthNamesTheLine) {
   expect_error([&] { SequenceReader r(dir_); }, "groundtruth.csv", "line 2");
   write_text(dir_ / "groundtruth.csv", "0,a,2,3,,,,,,,,,,,,\n");
   expect_error([&] { SequenceReader r(dir_); }, "groundtruth.csv", "'a' is not a number");
+  // Found by fuzz_sequence_csv: a frame beyond int was converted (undefined behaviour).
+  write_text(dir_ / "groundtruth.csv", "1e62,1,2,3,,,,,,,,,,,,\n");
+  expect_error([&] { SequenceReader r(dir_); }, "groundtruth.csv", "line 1: bad frame");
 }
 
 // Hostile files (issue 13): the checks happen on the header, before a pixel is decoded.

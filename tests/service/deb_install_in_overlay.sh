@@ -42,6 +42,15 @@ in_root setpriv --reuid=handtrack --regid=handtrack --clear-groups \
   || fail "handtrackd as user handtrack"
 [ "$(in_root stat -c '%a %U %G' /dev/shm/handtrack)" = "640 handtrack handtrack" ] \
   || fail "ring: $(in_root stat -c '%a %U %G' /dev/shm/handtrack)"
+# An .oni recording plays through the installed helper process (when the workspace has one).
+recording="${HANDTRACK_ONI_RECORDING:-}"
+if [ -n "$recording" ] && [ -f "$recording" ]; then
+  cp "$recording" "$r/tmp/recording.oni"
+  in_root setpriv --reuid=handtrack --regid=handtrack --clear-groups \
+    handtrackd --source oni:/tmp/recording.oni --fast --shm-name handtrack-oni --log-level warn > /dev/null \
+    || fail "handtrackd playing an .oni recording through /usr/libexec/handtrack/handtrack-source-helper"
+  echo "an .oni recording played through the installed source helper"
+fi
 # Python (as root, so it may leave bytecode next to the module: prerm must clean that up).
 in_root python3 -c 'import handtrack; print("python module", handtrack.__file__)'
 echo "installed package ok"

@@ -21,6 +21,7 @@ echo "built $(basename "$deb") ($(du -k "$deb" | cut -f1) KiB, $((SECONDS - t0))
 dpkg-deb -c "$deb" | awk '{print $6}' | sed 's#^\./#/#; s#/$##' > "$work/contents.txt"
 has() { grep -Eqx "$1" "$work/contents.txt" || fail "the package lacks $1"; }
 has /usr/sbin/handtrackd
+has /usr/libexec/handtrack/handtrack-source-helper
 has /usr/bin/handtrack-cat
 has /usr/lib/systemd/system/handtrackd.service
 has /usr/lib/udev/rules.d/59-handtrack-cameras.rules

@@ -49,14 +49,18 @@ constexpr std::int64_t kAnswerGraceNs = 2'000'000'000;
 // A helper told to stop (socket closed) gets this long to close its device before SIGKILL.
 constexpr std::int64_t kExitGraceNs = 2'000'000'000;
 
-// The helper program: $HANDTRACK_SOURCE_HELPER, else beside this executable (the build tree, a
-// relocated install), else the installed one.
+// The helper program: $HANDTRACK_SOURCE_HELPER, else beside this executable (the build tree),
+// else in ../libexec/handtrack from it (an install under any prefix), else where this build
+// installs it.
 std::string find_helper(std::string* looked) {
   if (const char* env = std::getenv(kHelperVariable); env != nullptr && *env != '\0') return env;
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
   std::vector<fs::path> places;
-  if (!ec) places.push_back(self.parent_path() / kHelperName);
+  if (!ec) {
+    places.push_back(self.parent_path() / kHelperName);
+    places.push_back(self.parent_path().parent_path() / "libexec" / "handtrack" / kHelperName);
+  }
   places.emplace_back(HANDTRACK_INSTALLED_SOURCE_HELPER);
   for (const auto& place : places) {
     if (::access(place.c_str(), X_OK) == 0) return place.string();
