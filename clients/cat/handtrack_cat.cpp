@@ -130,6 +130,8 @@ int main(int argc, char** argv) {
   double timeout_s = -1;
   bool latest_only = false;
   bool status_only = false;
+  bool smooth = false;
+  bool from_start = false;
   app.add_option("--shm-name", shm_name, "shared-memory object name")->capture_default_str();
   app.add_option("--count", count, "stop after N poses (0: never)")->check(CLI::NonNegativeNumber);
   app.add_option("--timeout", timeout_s,
@@ -138,6 +140,11 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_flag("--latest", latest_only, "print only the newest pose when several are waiting");
   app.add_flag("--status", status_only, "print the daemon's status and statistics once and exit");
+  app.add_flag("--from-start", from_start,
+               "begin with the oldest pose still in the ring instead of the next new one");
+  app.add_flag("--smooth", smooth,
+               "smooth joints, fingertips and palm with the client library's One Euro filter (its defaults; "
+               "docs/FILTER.md)");
   if (const auto exit_code = handtrack::parse_command_line(app, argc, argv, "handtrack-cat", 1)) return *exit_code;
   std::signal(SIGPIPE, SIG_IGN);  // a closed pipe (| head) ends us through fwrite's error
 
@@ -168,7 +175,9 @@ int main(int argc, char** argv) {
     return std::fflush(stdout) == 0 ? 0 : 1;
   }
 
+  if (from_start) client.rewind();
   handtrack_pose pose{};
+  handtrack::PoseFilter filter;
   std::uint64_t printed = 0;
   int last_trouble = HANDTRACK_OK;
   deadline = Clock::now() + timeout;
@@ -178,6 +187,7 @@ int main(int argc, char** argv) {
     const int st = latest_only ? client.wait_latest(pose, wait_for) : client.wait_next(pose, wait_for);
     if (st == HANDTRACK_OK) {
       last_trouble = HANDTRACK_OK;
+      if (smooth) filter.apply(pose);
       format_pose(pose, client.missed(), line);
       if (std::fwrite(line.text().data(), 1, line.text().size(), stdout) != line.text().size() ||
           std::fflush(stdout) != 0) {

@@ -71,6 +71,12 @@ int handtrack_wait_latest(handtrack_client* client, handtrack_pose* out, int64_t
   return remember(client, client->reader.wait_latest(*out, std::chrono::nanoseconds(timeout_ns)));
 }
 
+int handtrack_rewind(handtrack_client* client) {
+  if (client == nullptr || !client->reader.is_open()) return HANDTRACK_ERR_INVALID_ARGUMENT;
+  client->reader.rewind();
+  return HANDTRACK_OK;
+}
+
 uint64_t handtrack_missed(const handtrack_client* client) {
   return client != nullptr ? client->reader.missed() : 0;
 }

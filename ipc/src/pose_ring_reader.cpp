@@ -137,6 +137,14 @@ void PoseRingReader::close() noexcept {
   capacity_ = 0;
 }
 
+void PoseRingReader::rewind() noexcept {
+  if (header_ == nullptr) return;
+  // SYNC: acquire; pairs with the writer's release store of head. Slot head % capacity may be
+  // rewritten right now, so the oldest safe record is head - capacity + 1.
+  const std::uint64_t head = header_->head.load(std::memory_order_acquire);
+  next_index_ = head >= capacity_ ? head - capacity_ + 1 : 0;
+}
+
 std::uint64_t PoseRingReader::epoch() const noexcept {
   return header_ != nullptr ? header_->epoch : 0;
 }

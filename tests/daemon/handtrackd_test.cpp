@@ -140,7 +140,10 @@ TEST_F(Handtrackd, HelpExitsZero) {
 
 TEST_F(Handtrackd, SeqSourceFingertipsMatchGroundTruth) {
   ShmName shm("seq");
-  Child cat({kCat, "--shm-name", shm.str(), "--count", "40", "--timeout", "30"}, dir_ / "cat.out", dir_ / "cat.err");
+  // --from-start: the daemon plays the 60 frames in well under the cat's 50 ms poll for the ring,
+  // so a cat that only waited for new poses could attach after most of them.
+  Child cat({kCat, "--shm-name", shm.str(), "--count", "40", "--timeout", "30", "--from-start"}, dir_ / "cat.out",
+            dir_ / "cat.err");
   const auto r = run(daemon_args({"--source", "seq:" + pinch_.string(), "--fast", "--shm-name", shm.str()}), dir_,
                      "daemon", 60s);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -164,7 +167,8 @@ TEST_F(Handtrackd, SeqSourceFingertipsMatchGroundTruth) {
 
 TEST_F(Handtrackd, SyntheticSourceFingertipsMatchGroundTruth) {
   ShmName shm("synthetic");
-  Child cat({kCat, "--shm-name", shm.str(), "--count", "60", "--timeout", "30"}, dir_ / "cat.out", dir_ / "cat.err");
+  Child cat({kCat, "--shm-name", shm.str(), "--count", "60", "--timeout", "30", "--from-start"}, dir_ / "cat.out",
+            dir_ / "cat.err");
   const auto r = run(daemon_args({"--source", "synthetic:pinch", "--fast", "--frames", "90", "--shm-name", shm.str()}),
                      dir_, "daemon", 60s);
   ASSERT_EQ(r.code, 0) << r.err;

@@ -74,7 +74,27 @@ def check_pose(pose, epoch):
           f"{where}: dict shape")
 
 
+def check_filter():
+    """PoseFilter: the library's One Euro filter, reached from Python."""
+    smooth = handtrack.PoseFilter(beta=0.0, min_cutoff_hz=2.0)
+    poses = []
+    for i, x in enumerate([0.0, 100.0, 100.0]):
+        pose = handtrack.Pose()
+        pose.epoch, pose.state, pose.capture_ns = 1, 1, 1_000_000_000 + i * 16_666_667
+        pose.fingertips_mm[1][0] = x
+        poses.append(smooth.apply(pose).fingertips_mm[1][0])
+    check(poses[0] == 0.0 and 0.0 < poses[1] < poses[2] < 100.0, f"smoothed step {poses}")
+    check(handtrack.PoseFilter().params.min_cutoff_hz > 0, "defaults")
+    for bad in ({"beta": -1.0}, {"min_cutoff_hz": 0.0}):
+        try:
+            handtrack.PoseFilter(**bad)
+            check(False, f"PoseFilter({bad}) must raise")
+        except handtrack.HandtrackError:
+            pass
+
+
 def main():
+    check_filter()
     name = f"ht_py_{os.getpid()}"
     try:
         handtrack.Client(name)

@@ -20,7 +20,7 @@ import os
 
 __all__ = ["Client", "Pose", "Stats", "WriterStatus", "HandtrackError", "ABI_VERSION",
            "TIMEOUT", "NO_RECORD", "ERR_WRITER_DEAD", "ERR_WRITER_STOPPED",
-           "ERR_UNTRUSTED_OWNER"]
+           "ERR_UNTRUSTED_OWNER", "PoseFilter", "FilterParams"]
 
 ABI_VERSION = 1
 NUM_PARAMS = 26
@@ -148,6 +148,22 @@ _lib.handtrack_strerror.argtypes = [ctypes.c_int]
 _lib.handtrack_strerror.restype = ctypes.c_char_p
 _lib.handtrack_error_detail.restype = ctypes.c_char_p
 
+
+class FilterParams(ctypes.Structure):
+    """handtrack_filter_params: the One Euro filter's parameters (docs/FILTER.md)."""
+    _fields_ = [("min_cutoff_hz", ctypes.c_double), ("beta", ctypes.c_double),
+                ("d_cutoff_hz", ctypes.c_double), ("max_gap_s", ctypes.c_double)]
+
+
+_lib.handtrack_filter_default_params.argtypes = [ctypes.POINTER(FilterParams)]
+_lib.handtrack_filter_default_params.restype = None
+_lib.handtrack_filter_new.argtypes = [ctypes.POINTER(FilterParams), ctypes.POINTER(ctypes.c_void_p)]
+_lib.handtrack_filter_free.argtypes = [ctypes.c_void_p]
+_lib.handtrack_filter_free.restype = None
+_lib.handtrack_filter_reset.argtypes = [ctypes.c_void_p]
+_lib.handtrack_filter_reset.restype = None
+_lib.handtrack_filter_apply.argtypes = [ctypes.c_void_p, ctypes.POINTER(Pose)]
+
 if _lib.handtrack_abi_version() != ABI_VERSION:
     raise ImportError(f"handtrack: library ABI version {_lib.handtrack_abi_version()}, "
                       f"this module reads version {ABI_VERSION}")
@@ -237,3 +253,35 @@ class Client:
         if status != OK:
             raise _error(status)
         return out
+
+
+class PoseFilter:
+    """A One Euro filter over poses (the C library's handtrack_filter; docs/FILTER.md), one per
+    hand. `PoseFilter()` uses the documented defaults; keyword arguments override them, e.g.
+    `PoseFilter(min_cutoff_hz=0.5)`. `apply(pose)` smooths a Pose in place and returns it."""
+
+    def __init__(self, **params):
+        p = FilterParams()
+        _lib.handtrack_filter_default_params(ctypes.byref(p))
+        for name, value in params.items():
+            if name not in dict(FilterParams._fields_):
+                raise TypeError(f"PoseFilter: unknown parameter {name!r}")
+            setattr(p, name, float(value))
+        self.params = p
+        handle = ctypes.c_void_p()
+        status = _lib.handtrack_filter_new(ctypes.byref(p), ctypes.byref(handle))
+        if status != OK:
+            raise HandtrackError(status, f"PoseFilter: invalid parameters {params}")
+        self._handle = handle
+
+    def apply(self, pose):
+        _lib.handtrack_filter_apply(self._handle, ctypes.byref(pose))
+        return pose
+
+    def reset(self):
+        _lib.handtrack_filter_reset(self._handle)
+
+    def __del__(self):
+        if getattr(self, "_handle", None):
+            _lib.handtrack_filter_free(self._handle)
+            self._handle = None

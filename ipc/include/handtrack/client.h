@@ -184,6 +184,10 @@ HANDTRACK_API int handtrack_wait_next(handtrack_client* client, handtrack_pose* 
 /* Like handtrack_wait_next but returns the newest record, skipping (and counting) older ones. */
 HANDTRACK_API int handtrack_wait_latest(handtrack_client* client, handtrack_pose* out, int64_t timeout_ns);
 
+/* The next handtrack_wait_next returns the oldest record still in the ring instead of the next new
+ * one: what a client that attached late (a short recording played --fast) reads from. */
+HANDTRACK_API int handtrack_rewind(handtrack_client* client);
+
 /* Records skipped just before the record returned by the last successful read, and since open. */
 HANDTRACK_API uint64_t handtrack_missed(const handtrack_client* client);
 HANDTRACK_API uint64_t handtrack_missed_total(const handtrack_client* client);
@@ -199,6 +203,46 @@ HANDTRACK_API const char* handtrack_error_detail(void);
 HANDTRACK_API const char* handtrack_state_name(int32_t tracking_state);
 /* "stopped", "starting", "waiting_for_device", "streaming", "error" (or "unknown"). */
 HANDTRACK_API const char* handtrack_device_state_name(int32_t device_state);
+
+/*
+ * Smoothing: a One Euro filter (Casiez, Roussel, Vogel, CHI 2012) on every point of a pose (the
+ * 21 joints, 5 fingertips, palm centre and palm normal; params and the pinch fields are left as
+ * published). Each point is smoothed by an exponential filter whose cutoff frequency grows with
+ * the point's speed: f_c = min_cutoff_hz + beta * speed (mm/s), so a still hand loses its jitter
+ * and a moving one keeps up. The filter starts afresh (the pose passes through unchanged) on a new
+ * epoch (a restarted daemon), after a gap longer than max_gap_s, when capture time goes backwards,
+ * and while the state is not "tracking". Typical use:
+ *
+ *     handtrack_filter* f = NULL;
+ *     handtrack_filter_new(NULL, &f);               // NULL: the defaults below
+ *     ... handtrack_wait_next(c, &pose, ...); handtrack_filter_apply(f, &pose); use(&pose); ...
+ *     handtrack_filter_free(f);
+ *
+ * The defaults halve the fingertip jitter of the synthetic motions at 60 fps for at most one frame
+ * of lag (docs/FILTER.md). Thread roles: reentrant: one filter per hand, used by one thread at a time.
+ */
+#define HANDTRACK_FILTER_DEFAULT_MIN_CUTOFF_HZ 1.0
+#define HANDTRACK_FILTER_DEFAULT_BETA 0.01
+#define HANDTRACK_FILTER_DEFAULT_D_CUTOFF_HZ 1.0
+#define HANDTRACK_FILTER_DEFAULT_MAX_GAP_S 0.25
+
+typedef struct handtrack_filter_params {
+  double min_cutoff_hz; /* cutoff of a still point, Hz: lower is smoother, and slower */
+  double beta;          /* cutoff gained per mm/s of speed: higher follows fast moves closer */
+  double d_cutoff_hz;   /* cutoff of the speed estimate, Hz */
+  double max_gap_s;     /* a longer gap between two poses starts the filter afresh */
+} handtrack_filter_params;
+
+typedef struct handtrack_filter handtrack_filter; /* opaque */
+
+HANDTRACK_API void handtrack_filter_default_params(handtrack_filter_params* out);
+/* params NULL: the defaults. HANDTRACK_ERR_INVALID_ARGUMENT for non-finite or non-positive
+ * cutoffs or gap, or a negative beta. */
+HANDTRACK_API int handtrack_filter_new(const handtrack_filter_params* params, handtrack_filter** out);
+HANDTRACK_API void handtrack_filter_free(handtrack_filter* filter);
+HANDTRACK_API void handtrack_filter_reset(handtrack_filter* filter);
+/* Smooths `pose` in place (times from its capture_ns). Never allocates. */
+HANDTRACK_API int handtrack_filter_apply(handtrack_filter* filter, handtrack_pose* pose);
 
 /* What the library was built with, for bindings to check their layout against. */
 HANDTRACK_API uint32_t handtrack_abi_version(void);

@@ -13,6 +13,8 @@
 //     // HANDTRACK_TIMEOUT, _ERR_WRITER_DEAD, _ERR_WRITER_STOPPED: keep waiting; it reattaches itself
 //   }
 //
+// handtrack::PoseFilter (below) smooths poses with the C API's One Euro filter.
+//
 // Status values, not exceptions: reading poses is a hot path (STYLE: "the ipc reader returns
 // status values and never throws"). One Client belongs to one thread at a time.
 #pragma once
@@ -58,6 +60,7 @@ class Client {
   int wait_latest(handtrack_pose& out, std::chrono::nanoseconds timeout) noexcept {
     return handtrack_wait_latest(handle_, &out, static_cast<std::int64_t>(timeout.count()));
   }
+  int rewind() noexcept { return handtrack_rewind(handle_); }
   [[nodiscard]] std::uint64_t missed() const noexcept { return handtrack_missed(handle_); }
   [[nodiscard]] std::uint64_t missed_total() const noexcept { return handtrack_missed_total(handle_); }
   int writer_status(handtrack_writer_status& out) noexcept {
@@ -76,6 +79,47 @@ class Client {
 
  private:
   handtrack_client* handle_ = nullptr;
+};
+
+// A One Euro filter over poses (handtrack_filter_*; docs/FILTER.md): one per hand.
+//
+//   handtrack::PoseFilter smooth;                 // the documented defaults
+//   if (client.wait_next(pose, 1s) == HANDTRACK_OK) { smooth.apply(pose); use(pose); }
+class PoseFilter {
+ public:
+  // Default parameters; a PoseFilter is always usable (an invalid `params` falls back to them and
+  // ok() is false).
+  PoseFilter() noexcept { handtrack_filter_new(nullptr, &handle_); }
+  explicit PoseFilter(const handtrack_filter_params& params) noexcept {
+    ok_ = handtrack_filter_new(&params, &handle_) == HANDTRACK_OK;
+    if (!ok_) handtrack_filter_new(nullptr, &handle_);
+  }
+  ~PoseFilter() { handtrack_filter_free(handle_); }
+  PoseFilter(const PoseFilter&) = delete;
+  PoseFilter& operator=(const PoseFilter&) = delete;
+  PoseFilter(PoseFilter&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)), ok_(other.ok_) {}
+  PoseFilter& operator=(PoseFilter&& other) noexcept {
+    if (this != &other) {
+      handtrack_filter_free(handle_);
+      handle_ = std::exchange(other.handle_, nullptr);
+      ok_ = other.ok_;
+    }
+    return *this;
+  }
+
+  static handtrack_filter_params defaults() noexcept {
+    handtrack_filter_params p{};
+    handtrack_filter_default_params(&p);
+    return p;
+  }
+  [[nodiscard]] bool ok() const noexcept { return ok_ && handle_ != nullptr; }
+  // Smooths `pose` in place.
+  void apply(handtrack_pose& pose) noexcept { handtrack_filter_apply(handle_, &pose); }
+  void reset() noexcept { handtrack_filter_reset(handle_); }
+
+ private:
+  handtrack_filter* handle_ = nullptr;
+  bool ok_ = true;
 };
 
 }  // namespace handtrack

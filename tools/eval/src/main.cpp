@@ -23,12 +23,36 @@ using namespace handtrack;
 
 namespace {
 
-
 constexpr const char* kProgram = "handtrack-eval";
 
 std::string sequence_name(const fs::path& dir) {
   const auto name = fs::path(dir).lexically_normal().filename().string();
   return name.empty() ? fs::path(dir).lexically_normal().parent_path().filename().string() : name;
+}
+
+// --tips-csv: one row per frame with the estimated and the true fingertips.
+void write_tips_header(std::ostream& out) {
+  out << "sequence,frame,time_s,state";
+  for (const char* kind : {"est", "true"}) {
+    for (int f = 0; f < kNumFingers; ++f) {
+      for (const char axis : {'x', 'y', 'z'}) out << ',' << kind << f << '_' << axis;
+    }
+  }
+  out << '\n';
+}
+
+void write_tips_row(std::ostream& out, const std::string& sequence, size_t frame, double time_s,
+                    const TrackerOutput& estimate, const Fingertips& truth) {
+  out << sequence << ',' << frame << ',' << time_s << ',' << static_cast<int>(estimate.state);
+  for (const auto& tip : estimate.fingertips) out << ',' << tip.x() << ',' << tip.y() << ',' << tip.z();
+  for (const auto& tip : truth) {
+    if (tip) {
+      out << ',' << tip->x() << ',' << tip->y() << ',' << tip->z();
+    } else {
+      out << ",,,";
+    }
+  }
+  out << '\n';
 }
 
 }  // namespace
@@ -40,6 +64,7 @@ int main(int argc, char** argv) {
   std::string json_file;
   std::string plot_file;
   std::string csv_file;
+  std::string tips_file;
   std::string energy = "depth-only";
   TrackerConfig config;
   app.add_option("sequences", dirs, "sequence directories (SPEC.md format, with groundtruth.csv)")
@@ -48,6 +73,9 @@ int main(int argc, char** argv) {
   app.add_option("--json", json_file, "write the scores as JSON (SPEC.md)");
   app.add_option("--plot", plot_file, "write a PNG plot of the per-frame error");
   app.add_option("--csv", csv_file, "write per-frame errors as CSV (sequence,frame,error_mm)");
+  app.add_option("--tips-csv", tips_file,
+                 "write per-frame fingertips as CSV: sequence,frame,time_s,state, 15 estimated and 15 true "
+                 "coordinates (mm; empty where not annotated); what scripts/filter-table smooths");
   app.add_option("--energy", energy, "depth-only or late-fusion")->check(CLI::IsMember({"depth-only", "late-fusion"}));
   std::string forest_file;
   app.add_option("--forest", forest_file, "part-classification forest for late fusion (data/part_forest.htf)")
@@ -101,6 +129,12 @@ int main(int argc, char** argv) {
       }
       total_frames += readers.back().frame_count();
     }
+    std::ofstream tips_out;
+    if (!tips_file.empty()) {
+      tips_out.open(tips_file);
+      if (!tips_out) throw std::runtime_error(tips_file + ": cannot write");
+      write_tips_header(tips_out);
+    }
     tools::Progress progress(kProgram);
     size_t done = 0;
     for (const auto& reader : readers) {
@@ -114,6 +148,10 @@ int main(int argc, char** argv) {
         const TrackerOutput out = tracker.track(depth, labeller);
         seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         scorer.add(out, reader.fingertips(i));
+        if (tips_out.is_open()) {
+          write_tips_row(tips_out, sequence_name(reader.dir()), i, static_cast<double>(i) / reader.camera().fps, out,
+                         reader.fingertips(i));
+        }
         progress.update(sequence_name(reader.dir()), static_cast<double>(++done) / static_cast<double>(total_frames));
       }
       scores.push_back(scorer.finish(seconds));

@@ -51,6 +51,9 @@ class PoseRingReader {
   // Waits up to `timeout` for a record newer than the last one returned; returns the newest.
   Status wait_latest(PoseRecord& out, std::chrono::nanoseconds timeout) noexcept;
 
+  // The next record in order becomes the oldest one still in the ring (not the next new one).
+  void rewind() noexcept;
+
   // Records skipped just before the last record returned, and in total since open().
   [[nodiscard]] std::uint64_t missed() const noexcept { return missed_; }
   [[nodiscard]] std::uint64_t missed_total() const noexcept { return missed_total_; }
