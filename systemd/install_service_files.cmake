@@ -1,9 +1,10 @@
 # Runs inside `cmake --install` / CPack (install(CODE) in systemd/CMakeLists.txt), when the real
-# prefix is known: writes handtrackd.service with the daemon's and the configuration's actual
-# paths, and installs the default configuration without overwriting a changed one.
+# prefix is known: writes handtrackd.service and handtrack-ws.service with the programs' and the
+# configuration's actual paths and the shared sandbox, and installs the default configuration without overwriting a changed one.
 #
 # In: CMAKE_INSTALL_PREFIX (the install-time prefix), HANDTRACK_SERVICE_IN,
-# HANDTRACK_DEFAULT_CONFIG, HANDTRACK_STAGE_DIR, HANDTRACK_REL_{SBINDIR,SYSCONFDIR,DOCDIR,UNITDIR}.
+# HANDTRACK_WS_SERVICE_IN, HANDTRACK_SANDBOX_INC, HANDTRACK_DEFAULT_CONFIG, HANDTRACK_STAGE_DIR,
+# HANDTRACK_REL_{BINDIR,SBINDIR,SYSCONFDIR,DOCDIR,UNITDIR}.
 
 function(handtrack_abs out rel)
   if(IS_ABSOLUTE "${rel}")
@@ -25,11 +26,16 @@ else()
 endif()
 set(HANDTRACK_CONFDIR "${sysconfdir}/handtrack")
 handtrack_abs(HANDTRACK_SBINDIR "${HANDTRACK_REL_SBINDIR}")
+handtrack_abs(HANDTRACK_BINDIR "${HANDTRACK_REL_BINDIR}")
 handtrack_abs(HANDTRACK_DOCDIR "${HANDTRACK_REL_DOCDIR}")
 handtrack_abs(unitdir "${HANDTRACK_REL_UNITDIR}")
 
+file(READ "${HANDTRACK_SANDBOX_INC}" HANDTRACK_SANDBOX)
+string(STRIP "${HANDTRACK_SANDBOX}" HANDTRACK_SANDBOX)
 configure_file("${HANDTRACK_SERVICE_IN}" "${HANDTRACK_STAGE_DIR}/handtrackd.service" @ONLY)
-file(INSTALL DESTINATION "${unitdir}" TYPE FILE FILES "${HANDTRACK_STAGE_DIR}/handtrackd.service")
+configure_file("${HANDTRACK_WS_SERVICE_IN}" "${HANDTRACK_STAGE_DIR}/handtrack-ws.service" @ONLY)
+file(INSTALL DESTINATION "${unitdir}" TYPE FILE FILES "${HANDTRACK_STAGE_DIR}/handtrackd.service"
+  "${HANDTRACK_STAGE_DIR}/handtrack-ws.service")
 
 # The configuration is the administrator's once installed (a conffile in the .deb): a changed
 # file stays and the new default goes next to it as handtrackd.toml.new.

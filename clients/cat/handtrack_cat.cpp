@@ -1,15 +1,12 @@
 // handtrack-cat: print poses from handtrackd's shared memory, one JSON object a line.
 //
-// Fields (SPEC.md, "handtrack-cat"): frame, epoch, state, capture_ns, publish_ns, confidence,
-// energy, params (26), joints (21 x [x,y,z] mm), fingertips (5 x [x,y,z] mm, thumb..little),
-// pinch {distance_mm, strength}, missed; plus timings_ms, palm and hand_scale.
-// Numbers are printed with std::to_chars (shortest text that reads back to the same float or
-// double); a non-finite value is printed as null (JSON has no NaN).
+// The objects are clients/json/pose_json.hpp's (SPEC.md "handtrack-cat"), as handtrack-ws sends.
 #include <handtrack/client.hpp>
+
+#include "pose_json.hpp"
 
 #include "handtrack/common/cli.hpp"
 
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -19,105 +16,9 @@
 
 namespace {
 
-class Line {
- public:
-  void raw(const char* s) { text_ += s; }
-  void key(const char* k) {
-    text_ += '"';
-    text_ += k;
-    text_ += "\":";
-  }
-  template <typename T>
-  void number(T value) {
-    if constexpr (std::is_floating_point_v<T>) {
-      if (!std::isfinite(value)) {
-        text_ += "null";
-        return;
-      }
-    }
-    char buffer[32];
-    const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-    text_.append(buffer, result.ptr);
-  }
-  template <typename T>
-  void array(const T* values, int n) {
-    text_ += '[';
-    for (int i = 0; i < n; ++i) {
-      if (i > 0) text_ += ',';
-      number(values[i]);
-    }
-    text_ += ']';
-  }
-  template <typename T, int N>
-  void points(const T (*rows)[3]) {
-    text_ += '[';
-    for (int i = 0; i < N; ++i) {
-      if (i > 0) text_ += ',';
-      array(rows[i], 3);
-    }
-    text_ += ']';
-  }
-  std::string& text() { return text_; }
-
- private:
-  std::string text_;
-};
-
-void format_pose(const handtrack_pose& p, std::uint64_t missed, Line& out) {
-  out.text().clear();
-  out.raw("{");
-  out.key("frame"), out.number(p.frame), out.raw(",");
-  out.key("epoch"), out.number(p.epoch), out.raw(",");
-  out.key("state"), out.raw("\""), out.raw(handtrack_state_name(p.state)), out.raw("\",");
-  out.key("capture_ns"), out.number(p.capture_ns), out.raw(",");
-  out.key("publish_ns"), out.number(p.publish_ns), out.raw(",");
-  out.key("confidence"), out.number(p.confidence), out.raw(",");
-  out.key("energy"), out.number(p.energy), out.raw(",");
-  out.key("params"), out.array(p.params, HANDTRACK_NUM_PARAMS), out.raw(",");
-  out.key("joints"), out.points<float, HANDTRACK_NUM_JOINTS>(p.joints_mm), out.raw(",");
-  out.key("fingertips"), out.points<float, HANDTRACK_NUM_FINGERTIPS>(p.fingertips_mm), out.raw(",");
-  out.raw("\"pinch\":{");
-  out.key("distance_mm"), out.number(p.pinch_distance_mm), out.raw(",");
-  out.key("strength"), out.number(p.pinch_strength), out.raw("},");
-  out.raw("\"timings_ms\":{");
-  out.key("grab"), out.number(p.grab_ms), out.raw(",");
-  out.key("preprocess"), out.number(p.preprocess_ms), out.raw(",");
-  out.key("optimize"), out.number(p.optimize_ms), out.raw(",");
-  out.key("publish"), out.number(p.publish_ms), out.raw("},");
-  out.raw("\"palm\":{");
-  out.key("center_mm"), out.array(p.palm_center_mm, 3), out.raw(",");
-  out.key("normal"), out.array(p.palm_normal, 3), out.raw("},");
-  out.raw("\"hand_scale\":{");
-  out.key("length"), out.number(p.hand_scale[0]), out.raw(",");
-  out.key("width"), out.number(p.hand_scale[1]), out.raw(",");
-  out.key("sigma"), out.number(p.hand_scale[2]), out.raw("},");
-  out.key("missed"), out.number(missed);
-  out.raw("}\n");
-}
-
-void format_status(const handtrack_writer_status& s, Line& out) {
-  out.text().clear();
-  out.raw("{\"device_state\":\""), out.raw(handtrack_device_state_name(s.device_state)), out.raw("\",");
-  out.key("alive"), out.raw(s.alive != 0 ? "true," : "false,");
-  out.key("writer_pid"), out.number(s.writer_pid), out.raw(",");
-  out.key("epoch"), out.number(s.epoch), out.raw(",");
-  out.key("capacity"), out.number(s.capacity), out.raw(",");
-  out.key("records_published"), out.number(s.records_published), out.raw(",");
-  out.key("heartbeat_age_ms"), out.number(static_cast<double>(s.heartbeat_age_ns) / 1e6), out.raw(",");
-  out.key("heartbeat_period_ms"), out.number(static_cast<double>(s.heartbeat_period_ns) / 1e6), out.raw(",");
-  out.raw("\"stats\":{");
-  out.key("fps"), out.number(s.stats.fps), out.raw(",");
-  out.key("grab_ms"), out.number(s.stats.grab_ms), out.raw(",");
-  out.key("preprocess_ms"), out.number(s.stats.preprocess_ms), out.raw(",");
-  out.key("optimize_ms"), out.number(s.stats.optimize_ms), out.raw(",");
-  out.key("publish_ms"), out.number(s.stats.publish_ms), out.raw(",");
-  out.key("latency_p50_ms"), out.number(s.stats.latency_p50_ms), out.raw(",");
-  out.key("latency_p99_ms"), out.number(s.stats.latency_p99_ms), out.raw(",");
-  out.key("frames_captured"), out.number(s.stats.frames_captured), out.raw(",");
-  out.key("frames_dropped"), out.number(s.stats.frames_dropped), out.raw(",");
-  out.key("frames_skipped"), out.number(s.stats.frames_skipped), out.raw(",");
-  out.key("source_errors"), out.number(s.stats.source_errors), out.raw("}}\n");
-}
+using handtrack::json::format_pose;
+using handtrack::json::format_status;
+using handtrack::json::Line;
 
 int fail(const std::string& message) { return handtrack::report_error("handtrack-cat", message, 1); }
 
