@@ -3,12 +3,10 @@
 //   {"event":"pinch_start","frame":812,"position_mm":[12.5,-30.1,402.7],"distance_mm":11.2,"strength":0.86}
 //   {"event":"pinch_end","frame":851,"position_mm":[...],"distance_mm":34.0,"strength":0.12,"duration_ms":650.0,"reason":"released"}
 // position_mm is the midpoint of the thumb and index fingertips (camera frame, mm): where the
-// "click" happens. Start/end use hysteresis (pinch_detector.hpp); losing the hand ends a pinch
-// (reason "hand_lost" instead of "released").
+// "click" happens. Start/end come from the client library's gestures (handtrack::Gestures, with
+// hysteresis; docs/GESTURES.md); losing the hand ends a pinch (reason "hand_lost", not "released").
 //   Usage: pinch_click [--shm-name NAME] [--events N] [--timeout S]
 //   --events N: exit 0 after N events; --timeout S: exit 1 when no pose arrives for S seconds.
-#include "pinch_detector.hpp"
-
 #include <handtrack/client.hpp>
 
 #include <chrono>
@@ -21,14 +19,15 @@
 namespace {
 
 // duration_ms < 0 and reason == nullptr for pinch_start.
-void print_event(const char* event, const handtrack_pose& pose, double duration_ms, const char* reason) {
+void print_event(const char* event, const handtrack_pose& pose, float strength, double duration_ms,
+                 const char* reason) {
   float mid[3];
   for (int k = 0; k < 3; ++k) mid[k] = 0.5F * (pose.fingertips_mm[0][k] + pose.fingertips_mm[1][k]);
   std::printf("{\"event\":\"%s\",\"frame\":%llu,\"position_mm\":[%.1f,%.1f,%.1f],"
               "\"distance_mm\":%.1f,\"strength\":%.3f",
               event, static_cast<unsigned long long>(pose.frame), static_cast<double>(mid[0]),
               static_cast<double>(mid[1]), static_cast<double>(mid[2]),
-              static_cast<double>(pose.pinch_distance_mm), static_cast<double>(pose.pinch_strength));
+              static_cast<double>(pose.pinch_distance_mm), static_cast<double>(strength));
   if (duration_ms >= 0.0) std::printf(",\"duration_ms\":%.1f", duration_ms);
   if (reason != nullptr) std::printf(",\"reason\":\"%s\"", reason);
   std::printf("}\n");
@@ -65,7 +64,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pinch_click: %s\n", handtrack::Client::describe(status).c_str());
     return 1;
   }
-  handtrack::examples::PinchDetector detector;
+  handtrack::Gestures gestures;
   handtrack_pose pose{};
   long events = 0;
   std::int64_t start_ns = 0;
@@ -86,19 +85,20 @@ int main(int argc, char** argv) {
     }
     last_pose = now;
     // recovering still has a hand (the tracker restarts on it); only no_hand ends a pinch.
-    const bool tracked = pose.state != HANDTRACK_STATE_NO_HAND;
-    switch (detector.update(tracked, pose.pinch_distance_mm, pose.pinch_strength)) {
-      case handtrack::examples::PinchEvent::kStart:
+    const handtrack_gesture_state& g = gestures.update(pose);
+    const float strength = g.strength[HANDTRACK_GESTURE_PINCH];
+    switch (g.event[HANDTRACK_GESTURE_PINCH]) {
+      case HANDTRACK_GESTURE_START:
         start_ns = pose.capture_ns;
-        print_event("pinch_start", pose, -1.0, nullptr);
+        print_event("pinch_start", pose, strength, -1.0, nullptr);
         ++events;
         break;
-      case handtrack::examples::PinchEvent::kEnd:
-        print_event("pinch_end", pose, static_cast<double>(pose.capture_ns - start_ns) / 1e6,
-                    tracked ? "released" : "hand_lost");
+      case HANDTRACK_GESTURE_END:
+        print_event("pinch_end", pose, strength, static_cast<double>(pose.capture_ns - start_ns) / 1e6,
+                    pose.state != HANDTRACK_STATE_NO_HAND ? "released" : "hand_lost");
         ++events;
         break;
-      case handtrack::examples::PinchEvent::kNone:
+      default:
         break;
     }
   }

@@ -20,7 +20,7 @@ import os
 
 __all__ = ["Client", "Pose", "Stats", "WriterStatus", "HandtrackError", "ABI_VERSION",
            "TIMEOUT", "NO_RECORD", "ERR_WRITER_DEAD", "ERR_WRITER_STOPPED",
-           "ERR_UNTRUSTED_OWNER", "PoseFilter", "FilterParams"]
+           "ERR_UNTRUSTED_OWNER", "PoseFilter", "FilterParams", "Gestures", "GESTURE_NAMES"]
 
 ABI_VERSION = 1
 NUM_PARAMS = 26
@@ -164,6 +164,23 @@ _lib.handtrack_filter_reset.argtypes = [ctypes.c_void_p]
 _lib.handtrack_filter_reset.restype = None
 _lib.handtrack_filter_apply.argtypes = [ctypes.c_void_p, ctypes.POINTER(Pose)]
 
+NUM_GESTURES = 3
+GESTURE_NAMES = ("pinch", "grab", "point")  # handtrack_gesture order
+
+
+class GestureState(ctypes.Structure):
+    """handtrack_gesture_state: strength, active and event (0 none, 1 start, 2 end) per gesture."""
+    _fields_ = [("strength", ctypes.c_float * NUM_GESTURES), ("active", ctypes.c_int32 * NUM_GESTURES),
+                ("event", ctypes.c_int32 * NUM_GESTURES)]
+
+
+_lib.handtrack_gestures_new.argtypes = [ctypes.POINTER(ctypes.c_void_p)]
+_lib.handtrack_gestures_free.argtypes = [ctypes.c_void_p]
+_lib.handtrack_gestures_free.restype = None
+_lib.handtrack_gestures_reset.argtypes = [ctypes.c_void_p]
+_lib.handtrack_gestures_reset.restype = None
+_lib.handtrack_gestures_update.argtypes = [ctypes.c_void_p, ctypes.POINTER(Pose), ctypes.POINTER(GestureState)]
+
 if _lib.handtrack_abi_version() != ABI_VERSION:
     raise ImportError(f"handtrack: library ABI version {_lib.handtrack_abi_version()}, "
                       f"this module reads version {ABI_VERSION}")
@@ -284,4 +301,35 @@ class PoseFilter:
     def __del__(self):
         if getattr(self, "_handle", None):
             _lib.handtrack_filter_free(self._handle)
+            self._handle = None
+
+
+class Gestures:
+    """Gestures of one hand (the C library's handtrack_gestures; docs/GESTURES.md).
+
+    `update(pose)` returns a dict per gesture name: {"strength": 0..1, "active": bool,
+    "event": None | "start" | "end"}, with the library's hysteresis."""
+
+    _EVENTS = {0: None, 1: "start", 2: "end"}
+
+    def __init__(self):
+        handle = ctypes.c_void_p()
+        status = _lib.handtrack_gestures_new(ctypes.byref(handle))
+        if status != OK:
+            raise _error(status)
+        self._handle = handle
+        self._state = GestureState()
+
+    def update(self, pose):
+        _lib.handtrack_gestures_update(self._handle, ctypes.byref(pose), ctypes.byref(self._state))
+        return {name: {"strength": self._state.strength[g], "active": bool(self._state.active[g]),
+                       "event": self._EVENTS.get(self._state.event[g])}
+                for g, name in enumerate(GESTURE_NAMES)}
+
+    def reset(self):
+        _lib.handtrack_gestures_reset(self._handle)
+
+    def __del__(self):
+        if getattr(self, "_handle", None):
+            _lib.handtrack_gestures_free(self._handle)
             self._handle = None

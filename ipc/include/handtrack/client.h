@@ -218,11 +218,11 @@ HANDTRACK_API const char* handtrack_device_state_name(int32_t device_state);
  *     ... handtrack_wait_next(c, &pose, ...); handtrack_filter_apply(f, &pose); use(&pose); ...
  *     handtrack_filter_free(f);
  *
- * The defaults halve the fingertip jitter of the synthetic motions at 60 fps for at most one frame
- * of lag (docs/FILTER.md). Thread roles: reentrant: one filter per hand, used by one thread at a time.
+ * The defaults were chosen on the synthetic motions at 60 fps: the least fingertip jitter for at
+ * most one frame of added lag (docs/FILTER.md has the table). Thread roles: reentrant: one filter per hand, used by one thread at a time.
  */
 #define HANDTRACK_FILTER_DEFAULT_MIN_CUTOFF_HZ 1.0
-#define HANDTRACK_FILTER_DEFAULT_BETA 0.01
+#define HANDTRACK_FILTER_DEFAULT_BETA 0.05
 #define HANDTRACK_FILTER_DEFAULT_D_CUTOFF_HZ 1.0
 #define HANDTRACK_FILTER_DEFAULT_MAX_GAP_S 0.25
 
@@ -243,6 +243,50 @@ HANDTRACK_API void handtrack_filter_free(handtrack_filter* filter);
 HANDTRACK_API void handtrack_filter_reset(handtrack_filter* filter);
 /* Smooths `pose` in place (times from its capture_ns). Never allocates. */
 HANDTRACK_API int handtrack_filter_apply(handtrack_filter* filter, handtrack_pose* pose);
+
+/*
+ * Gestures (docs/GESTURES.md): from one hand's pose, a strength 0..1 for each gesture, and start/end
+ * events with hysteresis: a gesture starts when its strength rises above HANDTRACK_GESTURE_ON and
+ * ends when it falls below HANDTRACK_GESTURE_OFF or the hand is lost.
+ *   pinch  thumb and index tips together (1 at 20 mm between the tip centres, 0 from 60 mm)
+ *   grab   the fingers curled into a fist (middle..little weigh 3/4, the index 1/4)
+ *   point  the index extended while middle..little are curled
+ * A finger's curl is its reach (base to tip) over its length along the bones, from 0.95 (0) to
+ * 0.50 (1). Use one handtrack_gestures per hand. Thread roles: reentrant.
+ */
+typedef enum handtrack_gesture {
+  HANDTRACK_GESTURE_PINCH = 0,
+  HANDTRACK_GESTURE_GRAB = 1,
+  HANDTRACK_GESTURE_POINT = 2
+} handtrack_gesture;
+#define HANDTRACK_NUM_GESTURES 3
+#define HANDTRACK_GESTURE_ON 0.8f
+#define HANDTRACK_GESTURE_OFF 0.5f
+
+typedef enum handtrack_gesture_event {
+  HANDTRACK_GESTURE_NONE = 0,
+  HANDTRACK_GESTURE_START = 1,
+  HANDTRACK_GESTURE_END = 2
+} handtrack_gesture_event;
+
+typedef struct handtrack_gesture_state {
+  float strength[HANDTRACK_NUM_GESTURES]; /* 0..1, by handtrack_gesture */
+  int32_t active[HANDTRACK_NUM_GESTURES]; /* 1 while the gesture is on */
+  int32_t event[HANDTRACK_NUM_GESTURES];  /* handtrack_gesture_event of this update */
+} handtrack_gesture_state;
+
+typedef struct handtrack_gestures handtrack_gestures; /* opaque: the hysteresis of one hand */
+
+/* The strengths of one pose, without state (all 0 without a hand). */
+HANDTRACK_API void handtrack_gesture_strengths(const handtrack_pose* pose, float out[HANDTRACK_NUM_GESTURES]);
+HANDTRACK_API int handtrack_gestures_new(handtrack_gestures** out);
+HANDTRACK_API void handtrack_gestures_free(handtrack_gestures* gestures);
+HANDTRACK_API void handtrack_gestures_reset(handtrack_gestures* gestures);
+/* One pose of the hand in order: strengths, which gestures are on, and what started or ended. */
+HANDTRACK_API int handtrack_gestures_update(handtrack_gestures* gestures, const handtrack_pose* pose,
+                                            handtrack_gesture_state* out);
+/* "pinch", "grab", "point" (or "unknown"). */
+HANDTRACK_API const char* handtrack_gesture_name(int gesture);
 
 /* What the library was built with, for bindings to check their layout against. */
 HANDTRACK_API uint32_t handtrack_abi_version(void);

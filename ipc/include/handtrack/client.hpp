@@ -13,7 +13,8 @@
 //     // HANDTRACK_TIMEOUT, _ERR_WRITER_DEAD, _ERR_WRITER_STOPPED: keep waiting; it reattaches itself
 //   }
 //
-// handtrack::PoseFilter (below) smooths poses with the C API's One Euro filter.
+// handtrack::PoseFilter (below) smooths poses with the C API's One Euro filter; handtrack::Gestures
+// turns them into gesture strengths and events.
 //
 // Status values, not exceptions: reading poses is a hot path (STYLE: "the ipc reader returns
 // status values and never throws"). One Client belongs to one thread at a time.
@@ -120,6 +121,41 @@ class PoseFilter {
  private:
   handtrack_filter* handle_ = nullptr;
   bool ok_ = true;
+};
+
+// Gestures of one hand (handtrack_gesture*; docs/GESTURES.md): strengths and start/end events.
+//
+//   handtrack::Gestures gestures;
+//   const handtrack_gesture_state& g = gestures.update(pose);
+//   if (g.event[HANDTRACK_GESTURE_PINCH] == HANDTRACK_GESTURE_START) click();
+class Gestures {
+ public:
+  Gestures() noexcept { handtrack_gestures_new(&handle_); }
+  ~Gestures() { handtrack_gestures_free(handle_); }
+  Gestures(const Gestures&) = delete;
+  Gestures& operator=(const Gestures&) = delete;
+  Gestures(Gestures&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)), state_(other.state_) {}
+  Gestures& operator=(Gestures&& other) noexcept {
+    if (this != &other) {
+      handtrack_gestures_free(handle_);
+      handle_ = std::exchange(other.handle_, nullptr);
+      state_ = other.state_;
+    }
+    return *this;
+  }
+
+  // The next pose of this hand, in order.
+  const handtrack_gesture_state& update(const handtrack_pose& pose) noexcept {
+    handtrack_gestures_update(handle_, &pose, &state_);
+    return state_;
+  }
+  void reset() noexcept { handtrack_gestures_reset(handle_); }
+  [[nodiscard]] const handtrack_gesture_state& state() const noexcept { return state_; }
+  static const char* name(int gesture) noexcept { return handtrack_gesture_name(gesture); }
+
+ private:
+  handtrack_gestures* handle_ = nullptr;
+  handtrack_gesture_state state_{};
 };
 
 }  // namespace handtrack

@@ -1,0 +1,117 @@
+// Gestures of the client library on tracked synthetic motions with known gestures: the synthetic
+// pinch closes and opens the thumb and index, flexex1 makes a fist and opens it, fingercount
+// starts each count from a fist with the index alone (pointing). The events from the tracker's
+// poses must come at the frames where the same gestures happen in the ground truth (its joints
+// through the same library), neither missed nor doubled: every pinch of the pinch motion, and
+// the fists of flexex1's slow half. In the fast half the tracker does not close its fists (grab
+// strength peaks at 0.6-0.76 where the truth reaches 1) and at the start of fingercount it does not
+// find the initial fist: docs/GESTURES.md has the figures; those are tracker limits (the issue
+// "Every hand, every view"), so there only the ground truth's events are checked.
+#include "handtrack/core/tracker.hpp"
+#include "handtrack/synth/synthetic_camera.hpp"
+
+#include <handtrack/client.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace handtrack;
+
+constexpr int kFrames = 300;  // the daemon's synthetic camera: slow first half, fast second half
+
+template <typename Points>
+void copy_points(const Points& points, float (*out)[3], size_t n) {
+  for (size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) out[i][k] = static_cast<float>(points[i][k]);
+  }
+}
+
+struct Event {
+  int frame;
+  int kind;  // HANDTRACK_GESTURE_START or _END
+};
+
+// Events of `gesture` from tracked poses and from the ground truth of `motion`.
+std::pair<std::vector<Event>, std::vector<Event>> events_of(const std::string& motion, int gesture, int frames) {
+  synth::SyntheticCamera camera(synth::live_camera_options(motion, kFrames, 1, 60));
+  Tracker tracker(TrackerConfig{});
+  handtrack::Gestures tracked;
+  handtrack::Gestures truth;
+  std::vector<Event> from_tracker;
+  std::vector<Event> from_truth;
+  synth::SynthFrame frame;
+  for (int i = 0; i < frames; ++i) {
+    camera.render(i, frame);
+    const TrackerOutput out = tracker.track(frame.depth);
+    handtrack_pose pose{};
+    pose.state = static_cast<int32_t>(out.state);
+    copy_points(out.joints, pose.joints_mm, HANDTRACK_NUM_JOINTS);
+    copy_points(out.fingertips, pose.fingertips_mm, HANDTRACK_NUM_FINGERTIPS);
+    if (const int e = tracked.update(pose).event[gesture]; e != HANDTRACK_GESTURE_NONE) from_tracker.push_back({i, e});
+    handtrack_pose real{};
+    real.state = HANDTRACK_STATE_TRACKING;
+    copy_points(frame.joints, real.joints_mm, HANDTRACK_NUM_JOINTS);
+    std::array<Eigen::Vector3d, 5> tips;
+    for (size_t t = 0; t < 5; ++t) tips[t] = *frame.fingertips[t];
+    copy_points(tips, real.fingertips_mm, HANDTRACK_NUM_FINGERTIPS);
+    if (const int e = truth.update(real).event[gesture]; e != HANDTRACK_GESTURE_NONE) from_truth.push_back({i, e});
+  }
+  return {from_tracker, from_truth};
+}
+
+std::string describe(const std::vector<Event>& events) {
+  std::string s;
+  for (const auto& e : events) s += (e.kind == HANDTRACK_GESTURE_START ? " start@" : " end@") + std::to_string(e.frame);
+  return s.empty() ? " none" : s;
+}
+
+// `tolerance` in frames at 60 fps.
+void expect_same_events(const std::string& motion, int gesture, int frames, int at_least, int tolerance) {
+  const auto [tracked, truth] = events_of(motion, gesture, frames);
+  const std::string what = motion + " / " + handtrack_gesture_name(gesture) + ": tracked" + describe(tracked) +
+                           "; truth" + describe(truth);
+  EXPECT_GE(static_cast<int>(truth.size()), at_least) << what;
+  ASSERT_EQ(tracked.size(), truth.size()) << what;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    EXPECT_EQ(tracked[i].kind, truth[i].kind) << what;
+    EXPECT_LE(std::abs(tracked[i].frame - truth[i].frame), tolerance) << what;
+  }
+  std::cout << what << "\n";
+}
+
+// Within 200 ms (the first pinch starts 11 frames late while the tracker settles; the others 0-3).
+TEST(GestureMotions, EveryPinchOfThePinchMotion) {
+  expect_same_events("pinch", HANDTRACK_GESTURE_PINCH, kFrames, 6, 12);
+}
+// Within 330 ms: the tracked fist curls more slowly than the true one (the start comes 16 frames
+// late, the end on time).
+TEST(GestureMotions, TheFistsOfFlexex1sSlowHalf) {
+  expect_same_events("flexex1", HANDTRACK_GESTURE_GRAB, kFrames / 2, 2, 20);
+}
+
+TEST(GestureMotions, PointingOfFingercountInTheGroundTruth) {
+  // Start and end alternate, and each start comes while the index alone is extended.
+  const auto [tracked, truth] = events_of("fingercount", HANDTRACK_GESTURE_POINT, kFrames);
+  ASSERT_GE(truth.size(), 4U) << describe(truth);
+  synth::SyntheticCamera camera(synth::live_camera_options("fingercount", kFrames, 1, 60));
+  for (size_t i = 0; i < truth.size(); ++i) {
+    EXPECT_EQ(truth[i].kind, i % 2 == 0 ? HANDTRACK_GESTURE_START : HANDTRACK_GESTURE_END) << describe(truth);
+    if (truth[i].kind != HANDTRACK_GESTURE_START) continue;
+    const synth::SynthFrame f = camera.render(truth[i].frame);
+    handtrack_pose real{};
+    real.state = HANDTRACK_STATE_TRACKING;
+    copy_points(f.joints, real.joints_mm, HANDTRACK_NUM_JOINTS);
+    float strength[HANDTRACK_NUM_GESTURES];
+    handtrack_gesture_strengths(&real, strength);
+    EXPECT_GT(strength[HANDTRACK_GESTURE_POINT], HANDTRACK_GESTURE_ON) << "frame " << truth[i].frame;
+    EXPECT_LT(strength[HANDTRACK_GESTURE_GRAB], HANDTRACK_GESTURE_ON) << "frame " << truth[i].frame;
+  }
+  std::cout << "fingercount / point: tracked" << describe(tracked) << "; truth" << describe(truth) << "\n";
+}
+
+}  // namespace
