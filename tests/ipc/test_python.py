@@ -1,9 +1,12 @@
 #!/usr/bin/env python3
 """The Python module reads real records from a real writer process, field by field.
 
-Environment (set by ctest): HANDTRACK_CLIENT_LIB, PYTHONPATH (clients/python), IPC_TEST_WRITER,
-HANDTRACK_EXAMPLE (clients/python/examples/print_poses.py).
+Environment (set by ctest): HANDTRACK_CLIENT_LIB, IPC_TEST_WRITER, HANDTRACK_EXAMPLE
+(clients/python/examples/print_poses.py), and either PYTHONPATH (clients/python: the source tree)
+or HANDTRACK_EXPECT_INSTALLED (the venv that `pip install ./clients/python` installed into, by
+python_package.sh).
 """
+import asyncio
 import ctypes
 import os
 import subprocess
@@ -93,7 +96,39 @@ def check_filter():
             pass
 
 
+def check_iteration(name, epoch):
+    """client.poses() and client.aposes(); arrays where NumPy is, lists where it is not."""
+    with handtrack.Client(name) as client:
+        poses = []
+        for pose in client.poses(timeout=5.0):
+            poses.append(pose)
+            if len(poses) == 5:
+                break
+        check(len(poses) == 5 and all(p.epoch == epoch for p in poses), "poses() iterator")
+        joints = poses[0].joints
+        if handtrack._np is not None:
+            check(getattr(joints, "shape", None) == (21, 3) and poses[0].fingertips.shape == (5, 3)
+                  and poses[0].pose_params.shape == (26,), f"NumPy arrays: {type(joints)}")
+        else:
+            check(isinstance(joints, list) and len(joints) == 21 and len(joints[0]) == 3, "lists without NumPy")
+
+        async def collect():
+            got = []
+            async for pose in client.aposes(timeout=5.0):
+                got.append(pose.frame)
+                if len(got) == 5:
+                    return got
+            return got
+        frames = asyncio.run(collect())
+        check(len(frames) == 5 and frames == sorted(frames), f"aposes() async iterator: {frames}")
+    print(f"python client: iteration ok, NumPy {'present' if handtrack._np is not None else 'absent'}")
+
+
 def main():
+    if os.environ.get("HANDTRACK_EXPECT_INSTALLED"):
+        root = os.path.realpath(os.environ["HANDTRACK_EXPECT_INSTALLED"])
+        check(os.path.realpath(handtrack.__file__).startswith(root),
+              f"the installed package is used: {handtrack.__file__}")
     check_filter()
     name = f"ht_py_{os.getpid()}"
     try:
@@ -122,6 +157,7 @@ def main():
                 check_pose(pose, epoch)
                 frames.append(pose.frame)
             check(len(frames) == 100, f"read {len(frames)} poses")
+            check_iteration(name, epoch)
             check(frames == list(range(frames[0], frames[0] + len(frames))) or client.missed_total > 0,
                   "in order, or the skips were counted")
             latest = client.latest()

@@ -51,8 +51,37 @@ if [ -n "$recording" ] && [ -f "$recording" ]; then
     || fail "handtrackd playing an .oni recording through /usr/libexec/handtrack/handtrack-source-helper"
   echo "an .oni recording played through the installed source helper"
 fi
-# Python (as root, so it may leave bytecode next to the module: prerm must clean that up).
+# Python (as root, so it may leave bytecode next to the module: prerm must clean that up), and the
+# browser bridge, both from the package, against the package's daemon.
 in_root python3 -c 'import handtrack; print("python module", handtrack.__file__)'
+in_root sh -c 'handtrackd --source synthetic:pinch --shm-name handtrack-live --log-level warn > /tmp/live.log 2>&1 &
+  daemon=$!
+  handtrack-ws --shm-name handtrack-live --port 0 > /tmp/ws.out 2>&1 &
+  bridge=$!
+  timeout 60 python3 - <<"PY"
+import re, time, urllib.request
+import handtrack
+deadline = time.monotonic() + 20
+while True:
+    try:
+        client = handtrack.Client("handtrack-live")
+        break
+    except handtrack.HandtrackError:
+        if time.monotonic() > deadline:
+            raise
+        time.sleep(0.1)
+poses = [p for _, p in zip(range(3), client.poses(timeout=10))]
+assert len(poses) == 3 and poses[0].state_name in ("tracking", "recovering", "no_hand"), poses
+print("python module read", len(poses), "poses from the installed daemon")
+while not re.search(r":([0-9]+)/", open("/tmp/ws.out").read()):
+    assert time.monotonic() < deadline, open("/tmp/ws.out").read()
+    time.sleep(0.1)
+port = re.search(r":([0-9]+)/", open("/tmp/ws.out").read()).group(1)
+page = urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=10).read().decode()
+assert "<canvas" in page, page[:200]
+print("handtrack-ws served its page on port", port)
+PY
+  status=$?; kill $daemon $bridge 2>/dev/null; wait; exit $status' || fail "the installed Python module and handtrack-ws against the installed daemon"
 echo "installed package ok"
 
 # An edited conffile survives remove and goes with purge.

@@ -23,6 +23,8 @@ has() { grep -Eqx "$1" "$work/contents.txt" || fail "the package lacks $1"; }
 has /usr/sbin/handtrackd
 has /usr/libexec/handtrack/handtrack-source-helper
 has /usr/bin/handtrack-cat
+has /usr/bin/handtrack-ws
+has /usr/lib/systemd/system/handtrack-ws.service
 has /usr/lib/systemd/system/handtrackd.service
 has /usr/lib/udev/rules.d/59-handtrack-cameras.rules
 has /usr/lib/sysusers.d/handtrack.conf

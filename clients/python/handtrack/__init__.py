@@ -12,11 +12,25 @@ record size against it and refuses to load on a mismatch.
             print(pose.frame, pose.state_name, pose.fingertips_mm[1][:])
 
 The library is found through $HANDTRACK_CLIENT_LIB, then the system's library path.
+
+Iterating: ``for pose in client.poses(): ...`` (or ``async for pose in client.aposes()`` in
+asyncio code). With NumPy installed, ``pose.joints``, ``pose.fingertips`` and ``pose.params`` are
+arrays (21x3, 5x3, 26); without it, lists. Smoothing (``PoseFilter``) and gestures (``Gestures``)
+come from the C library.
 """
 
+import asyncio
 import ctypes
 import ctypes.util
 import os
+import time
+
+try:
+    import numpy as _np
+except ImportError:  # NumPy is optional: lists instead of arrays
+    _np = None
+
+__version__ = "0.1.0"
 
 __all__ = ["Client", "Pose", "Stats", "WriterStatus", "HandtrackError", "ABI_VERSION",
            "TIMEOUT", "NO_RECORD", "ERR_WRITER_DEAD", "ERR_WRITER_STOPPED",
@@ -66,6 +80,21 @@ class Pose(ctypes.Structure):
     STATE_NAMES = {0: "no_hand", 1: "tracking", 2: "recovering"}
 
     @property
+    def joints(self):
+        """The 21 joints (mm, camera frame): a 21x3 NumPy array, or a list of [x, y, z]."""
+        return _array(self.joints_mm)
+
+    @property
+    def fingertips(self):
+        """The 5 fingertips, thumb to little: a 5x3 NumPy array, or a list of [x, y, z]."""
+        return _array(self.fingertips_mm)
+
+    @property
+    def pose_params(self):
+        """The 26 pose parameters: a NumPy array, or a list."""
+        return _array(self.params)
+
+    @property
     def state_name(self):
         return self.STATE_NAMES.get(self.state, "unknown")
 
@@ -80,6 +109,13 @@ class Pose(ctypes.Structure):
             "fingertips": [list(t) for t in self.fingertips_mm],
             "pinch": {"distance_mm": self.pinch_distance_mm, "strength": self.pinch_strength},
         }
+
+
+def _array(field):
+    """A copy of a ctypes array field: a NumPy array when NumPy is there, else nested lists."""
+    if _np is not None:
+        return _np.ctypeslib.as_array(field).copy()
+    return [list(row) if hasattr(row, "__len__") else row for row in field]
 
 
 class Stats(ctypes.Structure):
@@ -253,6 +289,35 @@ class Client:
         pose = Pose()
         status = _lib.handtrack_wait_latest(self._handle, ctypes.byref(pose), int(timeout * 1e9))
         return self._result(status, pose)
+
+    def poses(self, timeout=None, latest=False):
+        """Poses in order (the newest only with latest=True), as they come: for ever, or until
+        `timeout` seconds pass without one. A daemon that dies or restarts is waited for."""
+        wait = self.wait_latest if latest else self.wait_next
+        quiet_since = time.monotonic()
+        while True:
+            pose = wait(timeout=0.25)
+            if pose is not None:
+                quiet_since = time.monotonic()
+                yield pose
+            elif timeout is not None and time.monotonic() - quiet_since >= timeout:
+                return
+
+    __iter__ = poses
+
+    async def aposes(self, timeout=None, latest=False):
+        """`poses()` for asyncio: each wait runs in a worker thread, so the event loop stays free.
+        Use one client per task (a client is used by one thread at a time)."""
+        loop = asyncio.get_running_loop()
+        wait = self.wait_latest if latest else self.wait_next
+        quiet_since = time.monotonic()
+        while True:
+            pose = await loop.run_in_executor(None, wait, 0.25)
+            if pose is not None:
+                quiet_since = time.monotonic()
+                yield pose
+            elif timeout is not None and time.monotonic() - quiet_since >= timeout:
+                return
 
     @property
     def missed(self):
