@@ -10,6 +10,9 @@ and prints a Markdown table per motion (docs/FILTER.md):
 - lag: the delay s (frames, 0.1 steps) that best aligns the estimates with the truth, i.e. that
   minimises the mean |estimate_t - truth(t - s)| (truth interpolated linearly).
 - mean: the mean fingertip error (mm) as handtrack-eval scores it.
+- late truth: the p95 jitter of a perfect estimate one frame late (the truth of the frame
+  before): what the motion alone contributes at one frame of lag. The rest is the tracker's own
+  error changing from frame to frame, which a filter with at most a frame of lag cannot remove.
 
     filter_table.py TIPS_CSV [--min-cutoff HZ] [--beta B] [--d-cutoff HZ] [--sweep]
 """
@@ -113,14 +116,17 @@ def measure(sequences, params):
     for name, frames in sequences.items():
         raw = [fr["est"] for fr in frames]
         smooth = smoothed(frames, params)
-        m = motions.setdefault(name.rsplit("-seed", 1)[0], {"raw": ([], [], []), "smooth": ([], [], [])})
+        m = motions.setdefault(name.rsplit("-seed", 1)[0], {"raw": ([], [], []), "smooth": ([], [], []), "late": []})
+        late = [frames[max(i - 1, 0)]["truth"] if usable(frames[max(i - 1, 0)]) else frames[i]["est"]
+                for i in range(len(frames))]
+        m["late"].extend(jitter(frames, late))
         for key, estimates in (("raw", raw), ("smooth", smooth)):
             m[key][0].extend(jitter(frames, estimates))
             m[key][1].append(lag(frames, estimates))
             m[key][2].append(mean_error(frames, estimates))
     rows = []
     for motion, m in motions.items():
-        row = {"motion": motion}
+        row = {"motion": motion, "late": percentile(m["late"], 95)}
         for key in ("raw", "smooth"):
             jit, lags, errors = m[key]
             row[key] = (statistics.median(jit), percentile(jit, 95), statistics.mean(lags), statistics.mean(errors))
@@ -132,19 +138,19 @@ def table(rows, params):
     lines = [f"One Euro filter: min_cutoff_hz {params['min_cutoff_hz']}, beta {params['beta']}, "
              f"d_cutoff_hz {params['d_cutoff_hz']}", "",
              "| motion | jitter p50 raw / smoothed (mm) | jitter p95 raw / smoothed (mm) | p95 ratio "
-             "| lag raw / smoothed (frames) | mean error raw / smoothed (mm) |",
-             "|---|---:|---:|---:|---:|---:|"]
+             "| lag raw / smoothed (frames) | mean error raw / smoothed (mm) | p95 of the truth 1 frame late (mm) |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
     for r in rows + [overall(rows)]:
         (p50r, p95r, lagr, mr), (p50s, p95s, lags, ms) = r["raw"], r["smooth"]
         lines.append(f"| {r['motion']} | {p50r:.2f} / {p50s:.2f} | {p95r:.2f} / {p95s:.2f} | {p95s / p95r:.2f} "
-                     f"| {lagr:.1f} / {lags:.1f} | {mr:.2f} / {ms:.2f} |")
+                     f"| {lagr:.1f} / {lags:.1f} | {mr:.2f} / {ms:.2f} | {r['late']:.2f} |")
     return "\n".join(lines)
 
 
 def overall(rows):
     mean = lambda key, i: statistics.mean(r[key][i] for r in rows)  # noqa: E731
     return {"motion": "**mean**", "raw": tuple(mean("raw", i) for i in range(4)),
-            "smooth": tuple(mean("smooth", i) for i in range(4))}
+            "smooth": tuple(mean("smooth", i) for i in range(4)), "late": statistics.mean(r["late"] for r in rows)}
 
 
 def meets_goal(rows):

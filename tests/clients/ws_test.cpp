@@ -176,6 +176,7 @@ TEST_F(WsBridge, ASlowClientSlowsNeitherTheDaemonNorTheOthers) {
   // a stalled client still gets nearly every one.
   const auto published = last["frame"].get<uint64_t>() - first["frame"].get<uint64_t>() + 1;
   EXPECT_GT(published, 120U) << "the daemon kept its 60 fps";
+  std::cout << "beside a stalled client: " << received << " of " << published << " poses received\n";
   EXPECT_GE(received, static_cast<int>(0.9 * static_cast<double>(published)))
       << received << " of " << published << " poses\n"
       << bridge->logs();

@@ -168,6 +168,11 @@ def main():
                                      capture_output=True, text=True, timeout=30)
             check(example.returncode == 0 and example.stdout.count("frame ") == 3,
                   f"example: {example.returncode} {example.stdout!r} {example.stderr!r}")
+            gestures = subprocess.run([sys.executable, os.path.join(os.path.dirname(os.environ["HANDTRACK_EXAMPLE"]),
+                                                                    "gestures_async.py"),
+                                       "--shm-name", name, "--seconds", "1"],
+                                      capture_output=True, text=True, timeout=30)
+            check(gestures.returncode == 0, f"gestures example: {gestures.returncode} {gestures.stderr!r}")
             writer.terminate()
             writer.wait(timeout=10)
             # The writer marked the segment stopped: the client says so instead of waiting.
