@@ -337,7 +337,17 @@ class Client:
         return out
 
 
-class PoseFilter:
+class _Owned:
+    """Frees the C object in self._handle with `_free` when garbage-collected."""
+    _free = None
+
+    def __del__(self):
+        if getattr(self, "_handle", None):
+            type(self)._free(self._handle)
+            self._handle = None
+
+
+class PoseFilter(_Owned):
     """A One Euro filter over poses (the C library's handtrack_filter; docs/FILTER.md), one per
     hand. `PoseFilter()` uses the documented defaults; keyword arguments override them, e.g.
     `PoseFilter(min_cutoff_hz=0.5)`. `apply(pose)` smooths a Pose in place and returns it."""
@@ -360,16 +370,13 @@ class PoseFilter:
         _lib.handtrack_filter_apply(self._handle, ctypes.byref(pose))
         return pose
 
+    _free = _lib.handtrack_filter_free
+
     def reset(self):
         _lib.handtrack_filter_reset(self._handle)
 
-    def __del__(self):
-        if getattr(self, "_handle", None):
-            _lib.handtrack_filter_free(self._handle)
-            self._handle = None
 
-
-class Gestures:
+class Gestures(_Owned):
     """Gestures of one hand (the C library's handtrack_gestures; docs/GESTURES.md).
 
     `update(pose)` returns a dict per gesture name: {"strength": 0..1, "active": bool,
@@ -391,10 +398,7 @@ class Gestures:
                        "event": self._EVENTS.get(self._state.event[g])}
                 for g, name in enumerate(GESTURE_NAMES)}
 
+    _free = _lib.handtrack_gestures_free
+
     def reset(self):
         _lib.handtrack_gestures_reset(self._handle)
-
-    def __del__(self):
-        if getattr(self, "_handle", None):
-            _lib.handtrack_gestures_free(self._handle)
-            self._handle = None

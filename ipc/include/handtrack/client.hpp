@@ -29,43 +29,56 @@
 
 namespace handtrack {
 
-class Client {
+namespace detail {
+// A C handle this object owns and frees with Free: move-only.
+template <typename T, void (*Free)(T*)>
+class Owned {
  public:
-  Client() = default;
-  ~Client() { close(); }
-  Client(const Client&) = delete;
-  Client& operator=(const Client&) = delete;
-  Client(Client&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
-  Client& operator=(Client&& other) noexcept {
+  Owned() = default;
+  ~Owned() { reset(); }
+  Owned(const Owned&) = delete;
+  Owned& operator=(const Owned&) = delete;
+  Owned(Owned&& other) noexcept : p_(std::exchange(other.p_, nullptr)) {}
+  Owned& operator=(Owned&& other) noexcept {
     if (this != &other) {
-      close();
-      handle_ = std::exchange(other.handle_, nullptr);
+      reset();
+      p_ = std::exchange(other.p_, nullptr);
     }
     return *this;
   }
+  void reset() noexcept {
+    if (p_ != nullptr) Free(std::exchange(p_, nullptr));
+  }
+  [[nodiscard]] T* get() const noexcept { return p_; }
+  T** out() noexcept { return &p_; }
 
+ private:
+  T* p_ = nullptr;
+};
+}  // namespace detail
+
+class Client {
+ public:
   // Maps `shm_name` read-only (closing any previous mapping).
   int open(const std::string& shm_name = HANDTRACK_DEFAULT_SHM_NAME) noexcept {
     close();
-    return handtrack_open(shm_name.c_str(), &handle_);
+    return handtrack_open(shm_name.c_str(), handle_.out());
   }
-  void close() noexcept {
-    if (handle_ != nullptr) handtrack_close(std::exchange(handle_, nullptr));
-  }
-  [[nodiscard]] bool is_open() const noexcept { return handle_ != nullptr; }
+  void close() noexcept { handle_.reset(); }
+  [[nodiscard]] bool is_open() const noexcept { return handle_.get() != nullptr; }
 
-  int latest(handtrack_pose& out) noexcept { return handtrack_latest(handle_, &out); }
+  int latest(handtrack_pose& out) noexcept { return handtrack_latest(handle_.get(), &out); }
   int wait_next(handtrack_pose& out, std::chrono::nanoseconds timeout) noexcept {
-    return handtrack_wait_next(handle_, &out, static_cast<std::int64_t>(timeout.count()));
+    return handtrack_wait_next(handle_.get(), &out, static_cast<std::int64_t>(timeout.count()));
   }
   int wait_latest(handtrack_pose& out, std::chrono::nanoseconds timeout) noexcept {
-    return handtrack_wait_latest(handle_, &out, static_cast<std::int64_t>(timeout.count()));
+    return handtrack_wait_latest(handle_.get(), &out, static_cast<std::int64_t>(timeout.count()));
   }
-  int rewind() noexcept { return handtrack_rewind(handle_); }
-  [[nodiscard]] std::uint64_t missed() const noexcept { return handtrack_missed(handle_); }
-  [[nodiscard]] std::uint64_t missed_total() const noexcept { return handtrack_missed_total(handle_); }
+  int rewind() noexcept { return handtrack_rewind(handle_.get()); }
+  [[nodiscard]] std::uint64_t missed() const noexcept { return handtrack_missed(handle_.get()); }
+  [[nodiscard]] std::uint64_t missed_total() const noexcept { return handtrack_missed_total(handle_.get()); }
   int writer_status(handtrack_writer_status& out) noexcept {
-    return handtrack_writer_status_get(handle_, &out);
+    return handtrack_writer_status_get(handle_.get(), &out);
   }
 
   // "<strerror>: <detail of the last failure in this thread>".
@@ -76,11 +89,12 @@ class Client {
     return text;
   }
 
-  [[nodiscard]] handtrack_client* native_handle() const noexcept { return handle_; }
+  [[nodiscard]] handtrack_client* native_handle() const noexcept { return handle_.get(); }
 
  private:
-  handtrack_client* handle_ = nullptr;
+  detail::Owned<handtrack_client, handtrack_close> handle_;
 };
+
 
 // A One Euro filter over poses (handtrack_filter_*; docs/FILTER.md): one per hand.
 //
@@ -90,22 +104,10 @@ class PoseFilter {
  public:
   // Default parameters; a PoseFilter is always usable (an invalid `params` falls back to them and
   // ok() is false).
-  PoseFilter() noexcept { handtrack_filter_new(nullptr, &handle_); }
+  PoseFilter() noexcept { handtrack_filter_new(nullptr, handle_.out()); }
   explicit PoseFilter(const handtrack_filter_params& params) noexcept {
-    ok_ = handtrack_filter_new(&params, &handle_) == HANDTRACK_OK;
-    if (!ok_) handtrack_filter_new(nullptr, &handle_);
-  }
-  ~PoseFilter() { handtrack_filter_free(handle_); }
-  PoseFilter(const PoseFilter&) = delete;
-  PoseFilter& operator=(const PoseFilter&) = delete;
-  PoseFilter(PoseFilter&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)), ok_(other.ok_) {}
-  PoseFilter& operator=(PoseFilter&& other) noexcept {
-    if (this != &other) {
-      handtrack_filter_free(handle_);
-      handle_ = std::exchange(other.handle_, nullptr);
-      ok_ = other.ok_;
-    }
-    return *this;
+    ok_ = handtrack_filter_new(&params, handle_.out()) == HANDTRACK_OK;
+    if (!ok_) handtrack_filter_new(nullptr, handle_.out());
   }
 
   static handtrack_filter_params defaults() noexcept {
@@ -113,13 +115,13 @@ class PoseFilter {
     handtrack_filter_default_params(&p);
     return p;
   }
-  [[nodiscard]] bool ok() const noexcept { return ok_ && handle_ != nullptr; }
+  [[nodiscard]] bool ok() const noexcept { return ok_ && handle_.get() != nullptr; }
   // Smooths `pose` in place.
-  void apply(handtrack_pose& pose) noexcept { handtrack_filter_apply(handle_, &pose); }
-  void reset() noexcept { handtrack_filter_reset(handle_); }
+  void apply(handtrack_pose& pose) noexcept { handtrack_filter_apply(handle_.get(), &pose); }
+  void reset() noexcept { handtrack_filter_reset(handle_.get()); }
 
  private:
-  handtrack_filter* handle_ = nullptr;
+  detail::Owned<handtrack_filter, handtrack_filter_free> handle_;
   bool ok_ = true;
 };
 
@@ -130,31 +132,19 @@ class PoseFilter {
 //   if (g.event[HANDTRACK_GESTURE_PINCH] == HANDTRACK_GESTURE_START) click();
 class Gestures {
  public:
-  Gestures() noexcept { handtrack_gestures_new(&handle_); }
-  ~Gestures() { handtrack_gestures_free(handle_); }
-  Gestures(const Gestures&) = delete;
-  Gestures& operator=(const Gestures&) = delete;
-  Gestures(Gestures&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)), state_(other.state_) {}
-  Gestures& operator=(Gestures&& other) noexcept {
-    if (this != &other) {
-      handtrack_gestures_free(handle_);
-      handle_ = std::exchange(other.handle_, nullptr);
-      state_ = other.state_;
-    }
-    return *this;
-  }
+  Gestures() noexcept { handtrack_gestures_new(handle_.out()); }
 
   // The next pose of this hand, in order.
   const handtrack_gesture_state& update(const handtrack_pose& pose) noexcept {
-    handtrack_gestures_update(handle_, &pose, &state_);
+    handtrack_gestures_update(handle_.get(), &pose, &state_);
     return state_;
   }
-  void reset() noexcept { handtrack_gestures_reset(handle_); }
+  void reset() noexcept { handtrack_gestures_reset(handle_.get()); }
   [[nodiscard]] const handtrack_gesture_state& state() const noexcept { return state_; }
   static const char* name(int gesture) noexcept { return handtrack_gesture_name(gesture); }
 
  private:
-  handtrack_gestures* handle_ = nullptr;
+  detail::Owned<handtrack_gestures, handtrack_gestures_free> handle_;
   handtrack_gesture_state state_{};
 };
 
