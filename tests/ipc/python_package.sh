@@ -4,9 +4,11 @@
 # Python tests (test_python.py) run against that installed package, not the source tree. The
 # venv sees Debian's python3-numpy, so poses give arrays here (test_python.py also runs without
 # NumPy, from the source tree, as ipc_python_client).
-#   python_package.sh SOURCE_DIR WORK_DIR   (HANDTRACK_CLIENT_LIB, IPC_TEST_WRITER, HANDTRACK_EXAMPLE set)
+# Last, the installed package reads poses from a real handtrackd (synthetic camera).
+#   python_package.sh SOURCE_DIR WORK_DIR HANDTRACKD
+#   (HANDTRACK_CLIENT_LIB, IPC_TEST_WRITER, HANDTRACK_EXAMPLE set)
 set -euo pipefail
-src="$1" work="$2"
+src="$1" work="$2" handtrackd="$3"
 rm -rf "$work" && mkdir -p "$work"
 /usr/bin/python3 -m venv --system-site-packages "$work/venv"
 "$work/venv/bin/python" -m pip install --no-index --no-cache-dir --disable-pip-version-check -q "$src/clients/python"
@@ -14,3 +16,27 @@ rm -rf "$work" && mkdir -p "$work"
 cd "$work"
 env -u PYTHONPATH HANDTRACK_EXPECT_INSTALLED="$work/venv" PYTHONDONTWRITEBYTECODE=1 \
   "$work/venv/bin/python" "$src/tests/ipc/test_python.py"
+
+name="htpy-daemon-$$"
+"$handtrackd" --config "$src/data/handtrackd.toml" --source synthetic:pinch --shm-name "$name" --log-level warn \
+  > "$work/daemon.log" 2>&1 &
+daemon=$!
+trap 'kill $daemon 2>/dev/null; wait $daemon 2>/dev/null; rm -f /dev/shm/$name' EXIT
+env -u PYTHONPATH timeout 60 "$work/venv/bin/python" - "$name" <<'PY'
+import sys, time
+import handtrack
+deadline = time.monotonic() + 30
+while True:
+    try:
+        client = handtrack.Client(sys.argv[1])
+        break
+    except handtrack.HandtrackError:
+        if time.monotonic() > deadline:
+            raise
+        time.sleep(0.1)
+poses = [p for _, p in zip(range(10), client.poses(timeout=10))]
+assert len(poses) == 10, len(poses)
+tracked = [p for p in poses if p.state_name == "tracking"]
+assert tracked and tracked[-1].joints.shape == (21, 3), [p.state_name for p in poses]
+print(f"installed package: {len(poses)} poses from handtrackd, joints as {type(tracked[-1].joints).__name__}")
+PY
