@@ -51,6 +51,42 @@ std::optional<Background> parse_background(std::string_view name) {
   return std::nullopt;
 }
 
+std::string_view handedness_name(Handedness hand) { return hand == Handedness::kLeft ? "left" : "right"; }
+
+std::optional<Handedness> parse_handedness(std::string_view name) {
+  for (auto h : {Handedness::kRight, Handedness::kLeft}) {
+    if (handedness_name(h) == name) return h;
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+// The camera the right hand is rendered with: for a left hand, the principal point mirrored
+// (synthetic_camera.hpp, Handedness), so that flipping the image gives the left hand in `camera`.
+CameraIntrinsics render_camera(const SynthOptions& options) {
+  CameraIntrinsics c = options.camera;
+  if (options.hand == Handedness::kLeft) c.cx = static_cast<double>(c.width - 1) - c.cx;
+  return c;
+}
+
+// The right hand's frame, rendered with render_camera(), into the left hand's: the image rows
+// reversed left to right, the joints' x negated.
+void mirror(SynthFrame& f) {
+  const int w = f.depth.camera.width;
+  for (int v = 0; v < f.depth.camera.height; ++v) {
+    const auto row = static_cast<std::ptrdiff_t>(v) * w;
+    std::reverse(f.depth.depth_mm.begin() + row, f.depth.depth_mm.begin() + row + w);
+    std::reverse(f.labels.pixels.begin() + row, f.labels.pixels.begin() + row + w);
+  }
+  for (auto& j : f.joints) j.x() = -j.x();
+  for (auto& t : f.fingertips) {
+    if (t) t->x() = -t->x();
+  }
+}
+
+}  // namespace
+
 CameraIntrinsics default_camera(int width, int height) {
   CameraIntrinsics c;
   c.width = width;
@@ -76,7 +112,7 @@ struct SyntheticCamera::State {
 
   State(SynthOptions o, const HandShape& s)
       : options(std::move(o)), shape(s), motion(options.motion, options.frames, options.camera.fps, shape),
-        raycaster(options.camera), background(options.camera) {}
+        raycaster(render_camera(options)), background(render_camera(options)) {}
 
   void apply_noise(int frame, SynthFrame& out) const;
 };
@@ -174,6 +210,7 @@ void SyntheticCamera::render_pose(const HandPose& pose, int frame, SynthFrame& o
       out.labels.pixels[i] = valid ? labels[i] : uint8_t{0};
     }
   }
+  if (s.options.hand == Handedness::kLeft) mirror(out);
 }
 
 void SyntheticCamera::State::apply_noise(int frame, SynthFrame& out) const {

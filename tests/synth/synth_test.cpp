@@ -428,3 +428,49 @@ TEST(SynthKinematics, AgreesWithTheTrackersSkeleton) {
 }
 
 }  // namespace
+
+// A left hand is the right hand's mirror image about the camera's x = 0 plane
+// (synthetic_camera.hpp, Handedness): its joints are the right hand's with x negated, and its
+// image is exactly the right hand's, rendered with the principal point mirrored, flipped left to
+// right; everything else (subject, motion, noise) is the same.
+TEST(SynthCamera, ALeftHandIsTheExactMirrorImageOfTheRightHand) {
+  handtrack::synth::SynthOptions left;
+  left.motion = "pinch";
+  left.frames = 60;
+  left.seed = 3;
+  left.noise = false;
+  left.hand = handtrack::synth::Handedness::kLeft;
+  handtrack::synth::SynthOptions right = left;
+  right.hand = handtrack::synth::Handedness::kRight;
+  right.camera.cx = static_cast<double>(right.camera.width - 1) - left.camera.cx;
+  handtrack::synth::SyntheticCamera left_cam(left);
+  handtrack::synth::SyntheticCamera right_cam(right);
+  EXPECT_EQ(left_cam.camera().cx, left.camera.cx) << "the left hand's sequence keeps the camera asked for";
+  for (const int i : {0, 25, 50}) {
+    const auto l = left_cam.render(i);
+    const auto r = right_cam.render(i);
+    for (size_t j = 0; j < l.joints.size(); ++j) {
+      EXPECT_DOUBLE_EQ(l.joints[j].x(), -r.joints[j].x());
+      EXPECT_DOUBLE_EQ(l.joints[j].y(), r.joints[j].y());
+      EXPECT_DOUBLE_EQ(l.joints[j].z(), r.joints[j].z());
+    }
+    const int w = l.depth.camera.width;
+    int hand_pixels = 0;
+    for (int v = 0; v < l.depth.camera.height; ++v) {
+      for (int u = 0; u < w; ++u) {
+        const size_t a = static_cast<size_t>(v * w + u);
+        const size_t b = static_cast<size_t>(v * w + (w - 1 - u));
+        ASSERT_EQ(l.depth.depth_mm[a], r.depth.depth_mm[b]) << "frame " << i << " pixel " << u << "," << v;
+        ASSERT_EQ(l.labels.pixels[a], r.labels.pixels[b]);
+        hand_pixels += l.labels.pixels[a] != 0 ? 1 : 0;
+      }
+    }
+    EXPECT_GT(hand_pixels, 500) << "a hand in view";
+    // The left thumb tip projects through the left camera onto the hand in the left image.
+    const Eigen::Vector2d uv = l.depth.camera.project(*l.fingertips[0]);
+    EXPECT_NE(l.labels.pixels[static_cast<size_t>(std::lround(uv.y())) * static_cast<size_t>(w) +
+                              static_cast<size_t>(std::lround(uv.x()))],
+              0)
+        << "frame " << i;
+  }
+}

@@ -79,6 +79,7 @@ TEST_F(SynthCli, BadArgumentsGiveOneClearLine) {
   expect_one_line_error("--motion pinch --frames 0 " + out, "--frames");
   expect_one_line_error("--motion pinch --frames many " + out, "--frames");
   expect_one_line_error("--motion pinch --frames 5 --background wall " + out, "--background");
+  expect_one_line_error("--motion pinch --frames 5 --hand both " + out, "--hand");
   expect_one_line_error("--motion pinch --frames 5 --subject-scale 3,1 " + out, "--subject-scale");
   expect_one_line_error("--motion pinch --frames 5 --subject-scale 1.0 " + out, "--subject-scale");
   expect_one_line_error("--motion pinch --frames 5 --width 0 " + out, "--width");
@@ -115,6 +116,7 @@ TEST_F(SynthCli, Writes640x480SequenceWithConsistentGroundTruth) {
   EXPECT_NEAR(reader.camera().fps, 60.0, 1e-9);
   ASSERT_TRUE(reader.has_groundtruth());
 
+  EXPECT_EQ(nlohmann::json::parse(slurp(seq / "hand.json")), nlohmann::json::parse(R"({"hands":["right"]})"));
   const auto subject = nlohmann::json::parse(slurp(seq / "subject.json"));
   EXPECT_DOUBLE_EQ(subject.at("length_scale").get<double>(), 1.08);
   EXPECT_DOUBLE_EQ(subject.at("width_scale").get<double>(), 0.94);

@@ -79,12 +79,20 @@ void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticC
                       {"noise", o.noise},
                       {"noise_sigma_k_per_mm", o.noise_params.sigma_k_per_mm},
                       {"background", std::string(handtrack::synth::background_name(o.background))},
+                      {"hand", std::string(handtrack::synth::handedness_name(o.hand))},
                       {"fingers", bones},
                       {"pose_parameters", "poses.csv: frame, t_x,t_y,t_z (mm, wrist), r_x,r_y,r_z (axis-angle, "
                                           "R = exp(r) diag(1,-1,-1)), thumb..little abd,flex1,flex2,flex3 (rad)"}};
   std::ofstream out(file);
   if (!out) throw std::runtime_error(file.string() + ": cannot write");
   out << j.dump(1) << "\n";
+}
+
+// SPEC.md "Sequence directory": hand.json, which hand the sequence shows.
+void write_hand_json(const fs::path& file, handtrack::synth::Handedness hand) {
+  std::ofstream out(file);
+  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  out << nlohmann::json{{"hands", {std::string(handtrack::synth::handedness_name(hand))}}}.dump() << "\n";
 }
 
 class PosesCsv {
@@ -125,6 +133,7 @@ int main(int argc, char** argv) {
   std::string out_dir;
   std::string subject;
   std::string background = "body";
+  std::string hand = "right";
   int frames = 300;
   int width = 320;
   int height = 240;
@@ -142,6 +151,7 @@ int main(int argc, char** argv) {
                                              "from the seed within +-10%)");
   app.add_flag("--noise,!--no-noise", options.noise, "Sensor noise model on (default) or off");
   app.add_option("--background", background, "Background: body (default), table or none");
+  app.add_option("--hand", hand, "right (default) or left: the right hand's exact mirror image");
   app.add_option("--width", width, "Image width (intrinsics scale with it)")->check(CLI::Range(16, 4096));
   app.add_option("--height", height, "Image height (intrinsics scale with it)")->check(CLI::Range(16, 4096));
   app.add_flag("--preview", preview, "Also write preview/NNNNNN.png (depth gray | labels in colour)");
@@ -163,11 +173,14 @@ int main(int argc, char** argv) {
   }
   const auto bg = handtrack::synth::parse_background(background);
   if (!bg) return fail("--background must be body, table or none, got '" + background + "'");
+  const auto handedness = handtrack::synth::parse_handedness(hand);
+  if (!handedness) return fail("--hand must be right or left, got '" + hand + "'");
 
   try {
     options.motion = motion;
     options.frames = frames;
     options.background = *bg;
+    options.hand = *handedness;
     options.camera = handtrack::synth::default_camera(width, height);
     if (!subject.empty()) options.subject = parse_subject(subject);
     handtrack::synth::SyntheticCamera cam(options);
@@ -176,6 +189,7 @@ int main(int argc, char** argv) {
     prepare_output(dir, force);
     handtrack::SequenceWriter writer(dir, cam.camera());
     write_subject_json(dir / "subject.json", cam);
+    write_hand_json(dir / "hand.json", *handedness);
     PosesCsv poses(dir / "poses.csv");
     if (preview) fs::create_directories(dir / "preview");
 

@@ -33,6 +33,15 @@ enum class Background {
 std::string_view background_name(Background background);
 std::optional<Background> parse_background(std::string_view name);
 
+// Which hand is shown. The hand model is a right hand; a left hand is its mirror image about the
+// camera's x = 0 plane, which a pinhole camera sees exactly as the right hand's image flipped left
+// to right when the right hand is rendered with the principal point at u = (width - 1) - cx:
+// (u_left - cx) = -(u_right - cx_right). So the left hand's depth, labels and joints are exact,
+// not an approximation, and share the subject, motion and noise of the right hand of that seed.
+enum class Handedness { kRight, kLeft };
+std::string_view handedness_name(Handedness hand);  // "right", "left"
+std::optional<Handedness> parse_handedness(std::string_view name);
+
 // The SPEC.md camera (fx 224.502, fy 230.494 at 320x240, principal point at the image centre,
 // 60 fps, 1 mm depth units) with the focal lengths scaled to width x height.
 CameraIntrinsics default_camera(int width = 320, int height = 240);
@@ -46,6 +55,7 @@ struct SynthOptions {
   Background background = Background::kBody;
   CameraIntrinsics camera = default_camera();
   NoiseParams noise_params;
+  Handedness hand = Handedness::kRight;
 };
 
 // The virtual camera as handtrackd's `synthetic[:MOTION]` source shows it: `frames` per pass of
@@ -55,7 +65,7 @@ SynthOptions live_camera_options(const std::string& motion, int frames, uint64_t
 
 struct SynthFrame {
   int frame = 0;
-  HandPose pose;
+  HandPose pose;         // the right-hand model's pose (a left hand shows its mirror image)
   DepthImage depth;      // mm, 0 = no measurement (noisy when options.noise)
   Gray8Image labels;     // part labels of hand_layout.hpp; 0 = background, forearm, or no depth
   Joints joints;         // 21 joints, mm, camera frame (TIP = tip-sphere centre)
