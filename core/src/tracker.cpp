@@ -49,6 +49,75 @@ const char* to_string(TrackingState state) {
   return "?";
 }
 
+const char* to_string(Handedness hand) { return hand == Handedness::kLeft ? "left" : "right"; }
+
+namespace {
+
+// The frame a camera takes of the scene's mirror image about x = 0 (Tracker): the rows reversed,
+// the principal point mirrored.
+void mirror_depth(const DepthImage& in, DepthImage& out) {
+  out.camera = in.camera;
+  out.camera.cx = static_cast<double>(in.camera.width - 1) - in.camera.cx;
+  out.depth_mm.resize(in.depth_mm.size());
+  const auto w = static_cast<std::ptrdiff_t>(in.camera.width);
+  for (std::ptrdiff_t row = 0; row + w <= static_cast<std::ptrdiff_t>(in.depth_mm.size()); row += w) {
+    std::reverse_copy(in.depth_mm.begin() + row, in.depth_mm.begin() + row + w, out.depth_mm.begin() + row);
+  }
+}
+
+// A pose found in the mirrored frame, back in the camera's: every point and direction reflected.
+void mirror_output(TrackerOutput& out) {
+  for (auto& j : out.joints) j.x() = -j.x();
+  for (auto& t : out.fingertips) t.x() = -t.x();
+  out.palm_centre.x() = -out.palm_centre.x();
+  out.palm_normal.x() = -out.palm_normal.x();
+}
+
+}  // namespace
+
+Tracker::Tracker(TrackerConfig config, HandednessMode mode)
+    : mode_(mode), right_(config), left_(config),
+      current_(mode == HandednessMode::kLeft ? Handedness::kLeft : Handedness::kRight) {}
+
+void Tracker::reset() {
+  right_.pose.reset();
+  left_.pose.reset();
+  tracking_ = false;
+}
+
+TrackerOutput Tracker::track_as(Handedness hand, const DepthImage& depth, const PixelLabeller* labeller) {
+  Side& s = side(hand);
+  if (hand == Handedness::kRight) return s.pose.optimise(s.builder.build(depth, s.pose.hint(), labeller));
+  mirror_depth(depth, mirrored_);
+  TrackerOutput out = s.pose.optimise(s.builder.build(mirrored_, s.pose.hint(), labeller));
+  mirror_output(out);
+  out.handedness = Handedness::kLeft;
+  return out;
+}
+
+TrackerOutput Tracker::track(const DepthImage& depth, const PixelLabeller* labeller) {
+  // One hand while it tracks (or when only one is considered); a frame after a lost or recovering
+  // one is a (re)start of both.
+  if (mode_ != HandednessMode::kAuto || tracking_) {
+    TrackerOutput out = track_as(current_, depth, labeller);
+    tracking_ = out.state == TrackingState::kTracking;
+    out.handedness_confidence = handedness_confidence_;
+    return out;
+  }
+  // Both hands from their own (re)start hypotheses; the one that explains more of the hand wins,
+  // and the other starts afresh next time.
+  TrackerOutput right = track_as(Handedness::kRight, depth, labeller);
+  TrackerOutput left = track_as(Handedness::kLeft, depth, labeller);
+  const bool left_wins = left.confidence > right.confidence;
+  current_ = left_wins ? Handedness::kLeft : Handedness::kRight;
+  side(left_wins ? Handedness::kRight : Handedness::kLeft).pose.reset();
+  handedness_confidence_ = std::clamp(std::abs(left.confidence - right.confidence), 0.0, 1.0);
+  TrackerOutput& out = left_wins ? left : right;
+  tracking_ = out.state == TrackingState::kTracking;
+  out.handedness_confidence = handedness_confidence_;
+  return out;
+}
+
 PoseTracker::PoseTracker(TrackerConfig config)
     : config_(config),
       model_(HandModel::default_adult(config.scale)),

@@ -30,6 +30,22 @@ std::string sequence_name(const fs::path& dir) {
   return name.empty() ? fs::path(dir).lexically_normal().parent_path().filename().string() : name;
 }
 
+// SPEC.md "Sequence directory": DIR/hand.json {"hands":["left"]} says which hand a sequence shows
+// (absent: unknown). Anything else in it is an error naming the file.
+std::optional<Handedness> read_hand_json(const fs::path& dir) {
+  const fs::path file = dir / "hand.json";
+  if (!fs::exists(file)) return std::nullopt;
+  std::ifstream in(file);
+  const auto j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_object() && j.contains("hands") && j["hands"].is_array() && j["hands"].size() == 1 &&
+      j["hands"][0].is_string()) {
+    const auto hand = j["hands"][0].get<std::string>();
+    if (hand == "left") return Handedness::kLeft;
+    if (hand == "right") return Handedness::kRight;
+  }
+  throw std::runtime_error(file.string() + ": expected {\"hands\":[\"left\"]} or {\"hands\":[\"right\"]}");
+}
+
 // --tips-csv: one row per frame with the estimated and the true fingertips.
 void write_tips_header(std::ostream& out) {
   out << "sequence,frame,time_s,state";
@@ -65,6 +81,7 @@ int main(int argc, char** argv) {
   std::string plot_file;
   std::string csv_file;
   std::string tips_file;
+  std::string hand = "auto";
   std::string energy = "depth-only";
   TrackerConfig config;
   app.add_option("sequences", dirs, "sequence directories (SPEC.md format, with groundtruth.csv)")
@@ -76,6 +93,8 @@ int main(int argc, char** argv) {
   app.add_option("--tips-csv", tips_file,
                  "write per-frame fingertips as CSV: sequence,frame,time_s,state, 15 estimated and 15 true "
                  "coordinates (mm; empty where not annotated); what scripts/filter-table smooths");
+  app.add_option("--hand", hand, "auto (default: both hands, the better fit chosen at every (re)start), right or left")
+      ->check(CLI::IsMember({"right", "left", "auto"}));
   app.add_option("--energy", energy, "depth-only or late-fusion")->check(CLI::IsMember({"depth-only", "late-fusion"}));
   std::string forest_file;
   app.add_option("--forest", forest_file, "part-classification forest for late fusion (data/part_forest.htf)")
@@ -138,8 +157,11 @@ int main(int argc, char** argv) {
     tools::Progress progress(kProgram);
     size_t done = 0;
     for (const auto& reader : readers) {
-      Tracker tracker(config);
-      eval::SequenceScorer scorer(sequence_name(reader.dir()));
+      const HandednessMode mode = hand == "auto" ? HandednessMode::kAuto
+                                  : hand == "left" ? HandednessMode::kLeft
+                                                   : HandednessMode::kRight;
+      Tracker tracker(config, mode);
+      eval::SequenceScorer scorer(sequence_name(reader.dir()), read_hand_json(reader.dir()));
       double seconds = 0.0;
       for (size_t i = 0; i < reader.frame_count(); ++i) {
         const DepthImage depth = reader.depth(i);

@@ -25,6 +25,14 @@ void SequenceScorer::add(const TrackerOutput& out, const Fingertips& truth) {
   ++score_.frames;
   if (!out.params.allFinite()) ++score_.nan_poses;
   if (out.detection_guided_won) ++score_.guided_wins;
+  if (out.state != TrackingState::kNoHand) {
+    ++score_.posed_frames;
+    score_.left_frames += out.handedness == Handedness::kLeft ? 1 : 0;
+    if (score_.expected_hand) {
+      ++score_.hand_known_frames;
+      score_.hand_correct += *score_.expected_hand == out.handedness ? 1 : 0;
+    }
+  }
   score_.per_frame_error_mm.push_back(fingertip_error_mm(out, truth));
 }
 
@@ -69,6 +77,10 @@ SequenceScore overall(const std::vector<SequenceScore>& sequences) {
     all.frames += s.frames;
     all.nan_poses += s.nan_poses;
     all.guided_wins += s.guided_wins;
+    all.posed_frames += s.posed_frames;
+    all.left_frames += s.left_frames;
+    all.hand_known_frames += s.hand_known_frames;
+    all.hand_correct += s.hand_correct;
     all.per_frame_error_mm.insert(all.per_frame_error_mm.end(), s.per_frame_error_mm.begin(),
                                   s.per_frame_error_mm.end());
     if (s.fps > 0.0) seconds += s.frames / s.fps;
@@ -102,6 +114,14 @@ nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const Sequen
     return j;
   };
   const auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  // Of the frames with a pose: the share reported left, and where the truth is known, right.
+  const auto hands = [&](const SequenceScore& s) {
+    const auto share = [&](int n, int of) { return of > 0 ? number(100.0 * n / of) : nlohmann::json(nullptr); };
+    nlohmann::json j = {{"pct_frames_left", share(s.left_frames, s.posed_frames)},
+                        {"pct_frames_correct", share(s.hand_correct, s.hand_known_frames)}};
+    if (s.expected_hand) j["expected"] = to_string(*s.expected_hand);
+    return j;
+  };
   nlohmann::json out;
   out["sequences"] = nlohmann::json::array();
   for (const auto& s : sequences) {
@@ -114,6 +134,7 @@ nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const Sequen
                                 {"mean_fingertip_error_mm", number(s.mean_error_mm)},
                                 {"max_fingertip_error_mm", number(s.max_error_mm)},
                                 {"pct_frames_below_mm", pct(s)},
+                                {"handedness", hands(s)},
                                 {"fps", s.fps}});
   }
   out["overall"] = {{"frames", total.frames},
@@ -123,6 +144,7 @@ nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const Sequen
                     {"detection_guided_wins", total.guided_wins},
                     {"mean_fingertip_error_mm", number(total.mean_error_mm)},
                     {"pct_frames_below_mm", pct(total)},
+                    {"handedness", hands(total)},
                     {"fps", total.fps}};
   return out;
 }

@@ -23,6 +23,13 @@ namespace handtrack {
 enum class TrackingState : uint8_t { kNoHand = 0, kTracking = 1, kRecovering = 2 };
 const char* to_string(TrackingState state);
 
+// Which hand a pose is of. The hand model is a right hand; a left hand is tracked as the right
+// hand of the mirrored image (Tracker, below).
+enum class Handedness : uint8_t { kRight = 0, kLeft = 1 };
+const char* to_string(Handedness hand);  // "right", "left"
+// Which hands a Tracker considers: one, or both (chosen at every (re)start by the better fit).
+enum class HandednessMode : uint8_t { kRight, kLeft, kAuto };
+
 // Which energies the particles optimise (Sec. 5).
 enum class EnergyMode {
   kDepthOnly,   // every particle: the depth-only energy (Sec. 4.1)
@@ -82,6 +89,10 @@ struct TrackerOutput {
   double pinch_strength = 0.0;       // 1 = touching, 0 = apart (>= 40 mm)
   int winning_particle = -1;         // -1: a (re)start, not a particle
   bool detection_guided_won = false;  // late fusion: the detection-guided particle won
+  Handedness handedness = Handedness::kRight;
+  // How clearly the last choice of hand was made, in [0, 1]: the chosen hand's confidence minus
+  // the other's at that (re)start (1 when only one hand is considered).
+  double handedness_confidence = 1.0;
 };
 
 class PoseTracker {
@@ -146,19 +157,43 @@ class PoseTracker {
 };
 
 // preprocess + optimise on one thread: what handtrack-eval and the single-threaded path use.
+// Depth image -> pose, for one hand at a time: the preprocessing (DepthInputBuilder) and the
+// optimiser (PoseTracker) of one hand, and the choice of hand.
+//
+// A left hand is the mirror image of a right hand about the camera's x = 0 plane, which the camera
+// sees exactly as the image flipped left to right with the principal point at
+// u = (width - 1) - cx (pixel centres at integer u). So a left hand is tracked as the right hand of
+// the mirrored image, by a second builder and tracker that only ever see mirrored images, and its
+// joints, fingertips, palm centre and normal are mirrored back (x negated); `params` stay those of
+// the right-hand model in the mirrored image. With HandednessMode::kAuto both hands are fitted at
+// every (re)start (no hand yet, lost, recovering) and the one that explains more of the hand
+// (confidence) is kept; while it tracks, only it runs.
 class Tracker {
  public:
-  explicit Tracker(TrackerConfig config = {}) : builder_(config.input), pose_(config) {}
-  TrackerOutput track(const DepthImage& depth, const PixelLabeller* labeller = nullptr) {
-    return pose_.optimise(builder_.build(depth, pose_.hint(), labeller));
-  }
-  [[nodiscard]] const DepthInput& last_input() const { return builder_.last(); }
-  [[nodiscard]] PoseTracker& pose_tracker() { return pose_; }
-  void reset() { pose_.reset(); }
+  explicit Tracker(TrackerConfig config = {}, HandednessMode mode = HandednessMode::kRight);
+  TrackerOutput track(const DepthImage& depth, const PixelLabeller* labeller = nullptr);
+  // The current hand's last input and tracker (for a left hand: of the mirrored image).
+  [[nodiscard]] const DepthInput& last_input() const { return side(current_).builder.last(); }
+  [[nodiscard]] PoseTracker& pose_tracker() { return side(current_).pose; }
+  void reset();
 
  private:
-  DepthInputBuilder builder_;
-  PoseTracker pose_;
+  struct Side {
+    explicit Side(const TrackerConfig& config) : builder(config.input), pose(config) {}
+    DepthInputBuilder builder;
+    PoseTracker pose;
+  };
+  [[nodiscard]] const Side& side(Handedness hand) const { return hand == Handedness::kLeft ? left_ : right_; }
+  Side& side(Handedness hand) { return hand == Handedness::kLeft ? left_ : right_; }
+  TrackerOutput track_as(Handedness hand, const DepthImage& depth, const PixelLabeller* labeller);
+
+  HandednessMode mode_;
+  Side right_;
+  Side left_;
+  Handedness current_ = Handedness::kRight;
+  double handedness_confidence_ = 1.0;
+  bool tracking_ = false;  // the current hand tracked in the last frame
+  DepthImage mirrored_;    // scratch: the mirrored frame for the left hand
 };
 
 }  // namespace handtrack

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,13 +32,23 @@ struct SequenceScore {
   double max_error_mm = 0.0;
   std::array<double, kThresholdsMm.size()> pct_below{};  // over annotated frames
   double fps = 0.0;            // single-threaded tracking rate (preprocessing + optimisation)
+  // Handedness (SPEC.md: DIR/hand.json says which hand a sequence shows): of the frames with a
+  // pose, how many were reported as a left hand, and, where the sequence says, as the right hand.
+  std::optional<Handedness> expected_hand;
+  int posed_frames = 0;
+  int left_frames = 0;
+  int hand_known_frames = 0;  // posed frames of sequences that say their hand
+  int hand_correct = 0;
   std::vector<double> per_frame_error_mm;  // NaN = not annotated, inf = no pose
 };
 
 // Accumulates one sequence's frames.
 class SequenceScorer {
  public:
-  explicit SequenceScorer(std::string name) { score_.name = std::move(name); }
+  explicit SequenceScorer(std::string name, std::optional<Handedness> expected_hand = std::nullopt) {
+    score_.name = std::move(name);
+    score_.expected_hand = expected_hand;
+  }
   void add(const TrackerOutput& out, const Fingertips& truth);
   SequenceScore finish(double tracking_seconds);
 

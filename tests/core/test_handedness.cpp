@@ -1,0 +1,122 @@
+// Left and right hands (Tracker with HandednessMode::kAuto): a left hand is tracked as the right
+// hand of the mirrored image, and the hand is chosen at every (re)start by the better fit.
+// - Synthetic left and right hands (the exact mirror image, synth --hand left): tracked as well as
+//   each other, each reported as its own hand.
+// - Real SR305 frames (right hands; ../shared/data, skipped where absent): the same frame mirrored
+//   left to right (image and cx) always fits as the other hand, with fingertips that are the
+//   mirror of the first fit's; and most frames fit as the right hand they are. Not all: in
+//   230536/170 the palm-facing right hand explains slightly more of the depth as a left hand seen
+//   from the back (a model of isotropic Gaussians is nearly the same seen from either side), the
+//   failure the issue "Every hand, every view" still has to remove.
+#include "handtrack/core/png_io.hpp"
+#include "handtrack/core/tracker.hpp"
+#include "handtrack/synth/synthetic_camera.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+
+namespace handtrack {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct HandRun {
+  double mean_error_mm = 0.0;
+  int posed = 0;
+  int reported_as_shown = 0;
+};
+
+HandRun track_synthetic(const std::string& motion, synth::Handedness hand, uint64_t seed) {
+  synth::SynthOptions options;
+  options.motion = motion;
+  options.frames = 120;
+  options.seed = seed;
+  options.hand = hand;
+  synth::SyntheticCamera camera(options);
+  Tracker tracker(TrackerConfig{}, HandednessMode::kAuto);
+  const Handedness shown = hand == synth::Handedness::kLeft ? Handedness::kLeft : Handedness::kRight;
+  HandRun run;
+  double sum = 0.0;
+  synth::SynthFrame frame;
+  for (int i = 0; i < options.frames; ++i) {
+    camera.render(i, frame);
+    const TrackerOutput out = tracker.track(frame.depth);
+    if (out.state == TrackingState::kNoHand) continue;
+    ++run.posed;
+    run.reported_as_shown += out.handedness == shown ? 1 : 0;
+    double e = 0.0;
+    for (size_t t = 0; t < 5; ++t) e += (out.fingertips[t] - *frame.fingertips[t]).norm();
+    sum += e / 5.0;
+  }
+  run.mean_error_mm = run.posed > 0 ? sum / run.posed : 1e9;
+  return run;
+}
+
+using HandCase = std::tuple<std::string, synth::Handedness, uint64_t>;
+class SyntheticHands : public ::testing::TestWithParam<HandCase> {};
+
+std::string case_name(const ::testing::TestParamInfo<HandCase>& c) {
+  return std::get<0>(c.param) + "_" + std::string(synth::handedness_name(std::get<1>(c.param)));
+}
+
+TEST_P(SyntheticHands, TrackedAndReportedAsTheHandTheyAre) {
+  const auto& [motion, hand, seed] = GetParam();
+  const HandRun run = track_synthetic(motion, hand, seed);
+  EXPECT_GE(run.posed, 114) << "a pose in at least 95 % of the frames";
+  EXPECT_LE(run.mean_error_mm, 12.0);
+  EXPECT_GE(run.reported_as_shown, static_cast<int>(0.98 * run.posed))
+      << run.reported_as_shown << " of " << run.posed << " frames reported as the " << synth::handedness_name(hand)
+      << " hand";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    LeftAndRight, SyntheticHands,
+    ::testing::Values(std::make_tuple("pinch", synth::Handedness::kRight, 11), std::make_tuple("pinch", synth::Handedness::kLeft, 11),
+                      std::make_tuple("fingerwave", synth::Handedness::kLeft, 12),
+                      std::make_tuple("adbadd", synth::Handedness::kLeft, 13)),
+    case_name);
+
+// The SR305's frames, fitted from scratch with the working volume these recordings need
+// (docs/TRACKER.md, "Real frames").
+TEST(RealHands, Sr305FramesAreRightHandsAndTheirMirrorImagesTheOtherHand) {
+  const fs::path dir = fs::path(HANDTRACK_SHARED_DATA_DIR) / "real-sr305" / "20210326-230536";
+  if (!fs::exists(dir)) GTEST_SKIP() << "shared data absent: " << dir;
+  const CameraIntrinsics cam{Sr305Camera::kWidth, Sr305Camera::kHeight, Sr305Camera::kFx, Sr305Camera::kFy,
+                             Sr305Camera::kCx,    Sr305Camera::kCy,     Sr305Camera::kDepthScaleMm, 30};
+  TrackerConfig config;
+  config.input.far_mm = 800.0;
+  int frames = 0;
+  int right_hands = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const auto raw = read_png_gray16(entry.path());
+    const DepthImage depth = DepthImage::from_raw(cam, raw.pixels);
+    DepthImage mirrored = depth;
+    mirrored.camera.cx = static_cast<double>(cam.width - 1) - cam.cx;
+    for (int v = 0; v < cam.height; ++v) {
+      const auto row = mirrored.depth_mm.begin() + static_cast<std::ptrdiff_t>(v) * cam.width;
+      std::reverse(row, row + cam.width);
+    }
+    Tracker as_seen(config, HandednessMode::kAuto);
+    Tracker as_mirrored(config, HandednessMode::kAuto);
+    const TrackerOutput right = as_seen.track(depth);
+    const TrackerOutput left = as_mirrored.track(mirrored);
+    const std::string name = entry.path().filename().string();
+    if (right.state == TrackingState::kNoHand) continue;  // beyond the working volume: nothing to say
+    ++frames;
+    right_hands += right.handedness == Handedness::kRight ? 1 : 0;
+    if (right.handedness != Handedness::kRight) std::cout << "fits as a left hand: " << name << "\n";
+    EXPECT_NE(left.handedness, right.handedness) << name << ": the mirror image is the other hand";
+    for (size_t t = 0; t < 5; ++t) {
+      const Eigen::Vector3d mirror_of_right(-right.fingertips[t].x(), right.fingertips[t].y(), right.fingertips[t].z());
+      EXPECT_LT((left.fingertips[t] - mirror_of_right).norm(), 10.0) << name << " fingertip " << t;
+    }
+  }
+  EXPECT_GE(frames, 6) << "frames with a hand in the working volume";
+  EXPECT_GE(4 * right_hands, 3 * frames) << right_hands << " of " << frames << " frames fit as a right hand";
+}
+
+}  // namespace
+}  // namespace handtrack
