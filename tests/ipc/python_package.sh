@@ -23,17 +23,9 @@ name="htpy-daemon-$$"
 daemon=$!
 trap 'kill $daemon 2>/dev/null; wait $daemon 2>/dev/null; rm -f /dev/shm/$name' EXIT
 env -u PYTHONPATH timeout 60 "$work/venv/bin/python" - "$name" <<'PY'
-import sys, time
+import sys
 import handtrack
-deadline = time.monotonic() + 30
-while True:
-    try:
-        client = handtrack.Client(sys.argv[1])
-        break
-    except handtrack.HandtrackError:
-        if time.monotonic() > deadline:
-            raise
-        time.sleep(0.1)
+client = handtrack.Client.wait_for(sys.argv[1], timeout=30)
 poses = [p for _, p in zip(range(10), client.poses(timeout=10))]
 assert len(poses) == 10, len(poses)
 tracked = [p for p in poses if p.state_name == "tracking"]

@@ -136,6 +136,13 @@ def main():
         check(False, "opening a missing segment must raise")
     except handtrack.HandtrackError as e:
         check(e.status == -2 and name in str(e), f"missing segment error: {e}")
+    started = time.monotonic()
+    try:
+        handtrack.Client.wait_for(name, timeout=0.3)
+        check(False, "wait_for a segment that never comes must raise")
+    except handtrack.HandtrackError as e:
+        waited = time.monotonic() - started
+        check(e.status == handtrack.ERR_NOT_FOUND and waited >= 0.3, f"wait_for: {e} after {waited:.2f} s")
 
     writer = subprocess.Popen([os.environ["IPC_TEST_WRITER"], "--name", name, "--rate-hz", "500",
                                "--capacity", "64"], stdout=subprocess.PIPE, text=True)

@@ -61,15 +61,8 @@ in_root sh -c 'handtrackd --source synthetic:pinch --shm-name handtrack-live --l
   timeout 60 python3 - <<"PY"
 import re, time, urllib.request
 import handtrack
+client = handtrack.Client.wait_for("handtrack-live", timeout=20)
 deadline = time.monotonic() + 20
-while True:
-    try:
-        client = handtrack.Client("handtrack-live")
-        break
-    except handtrack.HandtrackError:
-        if time.monotonic() > deadline:
-            raise
-        time.sleep(0.1)
 poses = [p for _, p in zip(range(3), client.poses(timeout=10))]
 assert len(poses) == 3 and poses[0].state_name in ("tracking", "recovering", "no_hand"), poses
 print("python module read", len(poses), "poses from the installed daemon")

@@ -44,6 +44,8 @@ NUM_FINGERTIPS = 5
 OK = 0
 TIMEOUT = 1
 NO_RECORD = 2
+ERR_NOT_FOUND = -2  # no segment of that name (the daemon has not started)
+ERR_NOT_READY = -4  # the daemon is still creating it
 ERR_WRITER_DEAD = -11
 ERR_WRITER_STOPPED = -12
 ERR_UNTRUSTED_OWNER = -15  # the segment's owner is not trusted (HANDTRACK_TRUSTED_USERS)
@@ -247,6 +249,20 @@ class Client:
             raise _error(status)
         self._handle = handle
         self.trouble = OK
+
+    @classmethod
+    def wait_for(cls, shm_name="handtrack", timeout=30.0):
+        """A Client as soon as the daemon's segment is there (it may start after this program),
+        waiting at most `timeout` seconds; other errors (permission, untrusted owner, version)
+        raise at once."""
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                return cls(shm_name)
+            except HandtrackError as e:
+                if e.status not in (ERR_NOT_FOUND, ERR_NOT_READY) or time.monotonic() >= deadline:
+                    raise
+            time.sleep(0.05)
 
     def close(self):
         if self._handle:
