@@ -83,6 +83,16 @@ void Tracker::reset() {
   right_.pose.reset();
   left_.pose.reset();
   tracking_ = false;
+  hand_id_ = 0;
+}
+
+void Tracker::identify(TrackerOutput& out) {
+  if (out.state == TrackingState::kNoHand) {
+    hand_id_ = 0;
+  } else if (hand_id_ == 0) {
+    hand_id_ = ++last_hand_id_;
+  }
+  out.hand_id = hand_id_;
 }
 
 TrackerOutput Tracker::track_as(Handedness hand, const DepthImage& depth, const PixelLabeller* labeller) {
@@ -102,6 +112,7 @@ TrackerOutput Tracker::track(const DepthImage& depth, const PixelLabeller* label
     TrackerOutput out = track_as(current_, depth, labeller);
     tracking_ = out.state == TrackingState::kTracking;
     out.handedness_confidence = handedness_confidence_;
+    identify(out);
     return out;
   }
   // Both hands from their own (re)start hypotheses; the one that explains more of the hand wins,
@@ -115,6 +126,7 @@ TrackerOutput Tracker::track(const DepthImage& depth, const PixelLabeller* label
   TrackerOutput& out = left_wins ? left : right;
   tracking_ = out.state == TrackingState::kTracking;
   out.handedness_confidence = handedness_confidence_;
+  identify(out);
   return out;
 }
 

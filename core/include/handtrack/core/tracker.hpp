@@ -93,6 +93,10 @@ struct TrackerOutput {
   // How clearly the last choice of hand was made, in [0, 1]: the chosen hand's confidence minus
   // the other's at that (re)start (1 when only one hand is considered).
   double handedness_confidence = 1.0;
+  // Which hand this is: a number that stays the same while the hand stays in view (through
+  // "recovering" frames and a change of the chosen hand) and is new each time a hand appears after
+  // a frame without one; 0 when there is no hand. Counts from 1 within one Tracker.
+  uint32_t hand_id = 0;
 };
 
 class PoseTracker {
@@ -186,6 +190,7 @@ class Tracker {
   [[nodiscard]] const Side& side(Handedness hand) const { return hand == Handedness::kLeft ? left_ : right_; }
   Side& side(Handedness hand) { return hand == Handedness::kLeft ? left_ : right_; }
   TrackerOutput track_as(Handedness hand, const DepthImage& depth, const PixelLabeller* labeller);
+  void identify(TrackerOutput& out);  // sets out.hand_id
 
   HandednessMode mode_;
   Side right_;
@@ -193,6 +198,8 @@ class Tracker {
   Handedness current_ = Handedness::kRight;
   double handedness_confidence_ = 1.0;
   bool tracking_ = false;  // the current hand tracked in the last frame
+  uint32_t hand_id_ = 0;   // of the hand in view; 0: none in the last frame
+  uint32_t last_hand_id_ = 0;
   DepthImage mirrored_;    // scratch: the mirrored frame for the left hand
 };
 
