@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
+#include <Eigen/Geometry>
 
 namespace handtrack {
 
@@ -13,6 +15,9 @@ namespace {
 // fist, a closed hand; each turned by a few in-plane rotations (rad) around the segmented axis.
 constexpr std::array<double, 3> kStartRotations = {0.0, 0.4, -0.4};
 constexpr std::array<bool, 2> kStartClosed = {false, true};
+// ... each with the palm toward the camera and with the back of the hand toward it (turned half a
+// turn about the hand's finger axis).
+constexpr std::array<bool, 2> kStartBack = {false, true};
 // Closed hand: [abd, flex1, flex2, flex3] for the thumb, then for each finger.
 constexpr std::array<double, 4> kClosedThumb = {0.3, 0.6, 0.5, 0.5};
 constexpr std::array<double, 4> kClosedFinger = {0.0, 1.3, 1.5, 0.9};
@@ -51,6 +56,25 @@ const char* to_string(TrackingState state) {
 
 const char* to_string(Handedness hand) { return hand == Handedness::kLeft ? "left" : "right"; }
 
+const char* to_string(HandednessMode mode) {
+  switch (mode) {
+    case HandednessMode::kRight: return "right";
+    case HandednessMode::kLeft: return "left";
+    case HandednessMode::kAuto: return "auto";
+  }
+  return "?";
+}
+
+bool parse_handedness_mode(const std::string& text, HandednessMode* mode) {
+  for (HandednessMode m : {HandednessMode::kAuto, HandednessMode::kLeft, HandednessMode::kRight}) {
+    if (text == to_string(m)) {
+      *mode = m;
+      return true;
+    }
+  }
+  return false;
+}
+
 namespace {
 
 // The frame a camera takes of the scene's mirror image about x = 0 (Tracker): the rows reversed,
@@ -75,15 +99,46 @@ void mirror_output(TrackerOutput& out) {
 
 }  // namespace
 
-Tracker::Tracker(TrackerConfig config, HandednessMode mode)
-    : mode_(mode), right_(config), left_(config),
-      current_(mode == HandednessMode::kLeft ? Handedness::kLeft : Handedness::kRight) {}
+TrackerInputs::TrackerInputs(const DepthInputConfig& config) : right_(config), left_(config) {}
+
+void TrackerInputs::build(const DepthImage& depth, const InputRequest& request, const PixelLabeller* labeller) {
+  has_right_ = request.right;
+  has_left_ = request.left;
+  if (has_right_) right_.build(depth, request.right_hint, labeller);
+  if (has_left_) {
+    mirror_depth(depth, mirrored_);
+    left_.build(mirrored_, request.left_hint, labeller);
+  }
+}
+
+Tracker::Tracker(const TrackerConfig& config)
+    : right_(config), left_(config), inputs_(config.input),
+      current_(config.handedness == HandednessMode::kLeft ? Handedness::kLeft : Handedness::kRight) {}
 
 void Tracker::reset() {
-  right_.pose.reset();
-  left_.pose.reset();
+  right_.reset();
+  left_.reset();
   tracking_ = false;
   hand_id_ = 0;
+}
+
+InputRequest Tracker::request() const {
+  const bool all = both();
+  InputRequest r;
+  r.right = all || current_ == Handedness::kRight;
+  r.left = all || current_ == Handedness::kLeft;
+  if (r.right) r.right_hint = right_.hint();
+  if (r.left) r.left_hint = left_.hint();
+  return r;
+}
+
+TrackerOutput Tracker::fit(Handedness hand, const DepthInput& input) {
+  TrackerOutput out = side(hand).optimise(input);
+  if (hand == Handedness::kLeft) {
+    mirror_output(out);
+    out.handedness = Handedness::kLeft;
+  }
+  return out;
 }
 
 void Tracker::identify(TrackerOutput& out) {
@@ -95,39 +150,63 @@ void Tracker::identify(TrackerOutput& out) {
   out.hand_id = hand_id_;
 }
 
-TrackerOutput Tracker::track_as(Handedness hand, const DepthImage& depth, const PixelLabeller* labeller) {
-  Side& s = side(hand);
-  if (hand == Handedness::kRight) return s.pose.optimise(s.builder.build(depth, s.pose.hint(), labeller));
-  mirror_depth(depth, mirrored_);
-  TrackerOutput out = s.pose.optimise(s.builder.build(mirrored_, s.pose.hint(), labeller));
-  mirror_output(out);
-  out.handedness = Handedness::kLeft;
-  return out;
+bool Tracker::prefer(const TrackerOutput& a, const TrackerOutput& b) const {
+  // A right hand with its palm toward the camera and a left hand with its back toward it (and the
+  // other way round) are mirror images through the hand's plane: a flat hand looks the same either
+  // way to the sphere model, and only finger flexion and the thumb's depth tell them apart. When
+  // the two explain the hand equally well (within handedness_margin) the palm toward the camera
+  // wins, the common view of a desk camera facing the user (docs/TRACKER.md, "Left hands").
+  const bool a_palm = a.palm_normal.z() < 0.0;
+  const bool b_palm = b.palm_normal.z() < 0.0;
+  if (a_palm != b_palm && std::abs(a.confidence - b.confidence) < config().handedness_margin) return a_palm;
+  return a.confidence > b.confidence;
 }
 
-TrackerOutput Tracker::track(const DepthImage& depth, const PixelLabeller* labeller) {
-  // One hand while it tracks (or when only one is considered); a frame after a lost or recovering
-  // one is a (re)start of both.
-  if (mode_ != HandednessMode::kAuto || tracking_) {
-    TrackerOutput out = track_as(current_, depth, labeller);
-    tracking_ = out.state == TrackingState::kTracking;
-    out.handedness_confidence = handedness_confidence_;
-    identify(out);
-    return out;
+bool Tracker::both() const {
+  if (config().handedness != HandednessMode::kAuto) return false;
+  const bool unsettled_check = !settled_ && frames_since_hand_check_ >= config().handedness_check_frames;
+  // The current hand's tracker gives no hint while it tracks only before a suspect-fit check.
+  return !tracking_ || unsettled_check || !side(current_).hint();
+}
+
+TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
+  const DepthInput* right = inputs.get(Handedness::kRight);
+  const DepthInput* left = inputs.get(Handedness::kLeft);
+  TrackerOutput out;
+  ++frames_since_hand_check_;
+  if (config().handedness == HandednessMode::kAuto && right != nullptr && left != nullptr) {
+    // Both hands, each from its history (the current one while it tracks) or its (re)start
+    // hypotheses; the one that explains more of the hand wins, the other starts afresh next time.
+    TrackerOutput as_right = fit(Handedness::kRight, *right);
+    TrackerOutput as_left = fit(Handedness::kLeft, *left);
+    const bool left_wins = prefer(as_left, as_right);
+    current_ = left_wins ? Handedness::kLeft : Handedness::kRight;
+    side(left_wins ? Handedness::kRight : Handedness::kLeft).reset();
+    handedness_confidence_ = std::clamp(std::abs(as_left.confidence - as_right.confidence), 0.0, 1.0);
+    settled_ = handedness_confidence_ >= config().handedness_margin;
+    frames_since_hand_check_ = 0;
+    out = left_wins ? as_left : as_right;
+  } else if (const DepthInput* input = current_ == Handedness::kLeft ? left : right) {
+    // One hand while it tracks (or when only one is considered).
+    out = fit(current_, *input);
+  } else {
+    // Built for another hand than the current one (a pipeline's frame preprocessed before the
+    // choice changed): fit the hand the frame was built for.
+    const Handedness other = current_ == Handedness::kLeft ? Handedness::kRight : Handedness::kLeft;
+    if (inputs.get(other) != nullptr && config().handedness == HandednessMode::kAuto) {
+      out = fit(other, *inputs.get(other));
+      current_ = other;
+    }
   }
-  // Both hands from their own (re)start hypotheses; the one that explains more of the hand wins,
-  // and the other starts afresh next time.
-  TrackerOutput right = track_as(Handedness::kRight, depth, labeller);
-  TrackerOutput left = track_as(Handedness::kLeft, depth, labeller);
-  const bool left_wins = left.confidence > right.confidence;
-  current_ = left_wins ? Handedness::kLeft : Handedness::kRight;
-  side(left_wins ? Handedness::kRight : Handedness::kLeft).pose.reset();
-  handedness_confidence_ = std::clamp(std::abs(left.confidence - right.confidence), 0.0, 1.0);
-  TrackerOutput& out = left_wins ? left : right;
   tracking_ = out.state == TrackingState::kTracking;
   out.handedness_confidence = handedness_confidence_;
   identify(out);
   return out;
+}
+
+TrackerOutput Tracker::track(const DepthImage& depth, const PixelLabeller* labeller) {
+  inputs_.build(depth, request(), labeller);
+  return optimise(inputs_);
 }
 
 PoseTracker::PoseTracker(TrackerConfig config)
@@ -166,13 +245,18 @@ std::optional<HandHint> PoseTracker::hint() const {
   return HandHint{t + camera_R_hand * model_.palm_centre(), t, camera_R_hand * Vector3d::UnitY()};
 }
 
-PoseParams PoseTracker::initial_pose(const DepthInput& input, double in_plane_offset_rad, bool closed) const {
+PoseParams PoseTracker::initial_pose(const DepthInput& input, double in_plane_offset_rad, bool closed,
+                                      bool back) const {
   // Frontal open hand (r = 0: fingers toward -y in the image) turned in the image plane onto the
-  // hand's axis: rotation phi about the camera z maps (0,-1) to (sin phi, -cos phi).
+  // hand's axis: rotation phi about the camera z maps (0,-1) to (sin phi, -cos phi). The back of
+  // the hand faces the camera after half a turn about the finger axis (the camera y axis at r = 0)
+  // first: R = Rz(phi) Ry(pi).
   const Vector3d& axis = input.finger_axis;
   const double phi = std::atan2(axis.x(), -axis.y()) + in_plane_offset_rad;
   PoseParams params = PoseParams::Zero();
-  params.segment<3>(kRotationParam) = Vector3d(0, 0, phi);
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(phi, Vector3d::UnitZ()).toRotationMatrix() *
+                               Eigen::AngleAxisd(back ? std::numbers::pi : 0.0, Vector3d::UnitY()).toRotationMatrix();
+  params.segment<3>(kRotationParam) = rotation_log(turn);
   if (closed) {
     for (int f = 0; f < kNumFingers; ++f) {
       for (int d = 0; d < 4; ++d) {
@@ -343,14 +427,16 @@ PoseTracker::Fit PoseTracker::restart(const DepthInput& input) {
   const EnergyFrame frame{&model_, &input, nullptr, nullptr};
   const PoseEnergy& energy = fuses(input) ? guided_energy_ : energy_;
   Fit best;
-  for (bool closed : kStartClosed) {
-    for (double offset : kStartRotations) {
-      const auto r = optimizer_.maximise(energy, frame, initial_pose(input, offset, closed), scratch_,
-                                         config_.init_iterations);
-      scratch_.update(model_, r.params);
-      const double c = confidence(input, scratch_);
-      if (c > best.confidence + 1e-9 || (c > best.confidence - 1e-9 && r.energy > best.result.energy)) {
-        best = Fit{r, c};
+  for (bool back : kStartBack) {
+    for (bool closed : kStartClosed) {
+      for (double offset : kStartRotations) {
+        const auto r = optimizer_.maximise(energy, frame, initial_pose(input, offset, closed, back), scratch_,
+                                           config_.init_iterations);
+        scratch_.update(model_, r.params);
+        const double c = confidence(input, scratch_);
+        if (c > best.confidence + 1e-9 || (c > best.confidence - 1e-9 && r.energy > best.result.energy)) {
+          best = Fit{r, c};
+        }
       }
     }
   }

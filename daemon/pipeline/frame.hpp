@@ -18,9 +18,9 @@ namespace handtrack::daemon {
 struct Frame {
   RawFrame raw;
   DepthImage depth;                    // mm
-  DepthInputBuilder builder;           // per frame: frame t+1 is preprocessed while t is optimized
-  uint64_t builder_generation = 0;     // the TrackerReload generation `builder` was made for
-  const DepthInput* input = nullptr;   // null: no depth in the working volume, or malformed
+  TrackerInputs inputs;                // per frame: frame t+1 is preprocessed while t is optimized
+  uint64_t inputs_generation = 0;      // the TrackerReload generation `inputs` was made for
+  bool has_input = false;              // false: no depth in the working volume, or malformed
   bool empty = false;                  // nothing in the working volume: published as no_hand
   bool malformed = false;              // buffer does not match its intrinsics: skipped
   bool resolution_changed = false;     // first frame of a new resolution: the tracker restarts

@@ -5,9 +5,9 @@
 
 namespace handtrack::daemon {
 
-OptimizeStage::OptimizeStage(const TrackerConfig& config, TrackerReload& reload, HintMailbox& hint,
+OptimizeStage::OptimizeStage(const TrackerConfig& config, TrackerReload& reload, RequestMailbox& request,
                              StageWatch& watch)
-    : reload_(reload), hint_(hint), watch_(watch) {
+    : reload_(reload), request_(request), watch_(watch) {
   tracker_.emplace(config);
 }
 
@@ -26,15 +26,15 @@ void OptimizeStage::step(Frame& f) {
   watch_.busy(Stage::kOptimize, f.seq, f.optimize_start_ns);
   apply_reload();
   if (f.resolution_changed) tracker_->reset();
-  if (f.input != nullptr) {
-    f.output = tracker_->optimise(*f.input);
+  if (f.has_input) {
+    f.output = tracker_->optimise(f.inputs);
   } else {
     tracker_->reset();
     f.output = TrackerOutput{};
   }
   f.scale = tracker_->config().scale;
-  // Hint for the next frames' segmentation (none after a loss: the next frame starts afresh).
-  hint_.put(tracker_->hint());
+  // What the next frames need (both hands and no hint after a loss: the next frame starts afresh).
+  request_.put(tracker_->request());
   f.optimize_end_ns = monotonic_ns();
   watch_.idle(Stage::kOptimize);
 }

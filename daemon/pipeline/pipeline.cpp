@@ -43,7 +43,7 @@ struct Pipeline::Impl {
   PipelineTally tally;
   StageWatch watch;
   std::optional<TrackerReload> reload;  // made at start(), with the energy mode the forest decides
-  HintMailbox hint;
+  RequestMailbox request;
   IntervalStats stats;
   std::optional<PartForest> forest;  // labels the hand's pixels for the detection-guided particle
   std::unique_ptr<Recorder> recorder;
@@ -244,7 +244,7 @@ struct Pipeline::Impl {
     pool.reserve(pool_size);
     for (size_t i = 0; i < pool_size; ++i) {
       auto f = std::make_unique<Frame>();
-      f->builder = preprocess->make_builder();
+      f->inputs = preprocess->make_inputs();
       f->raw.depth_raw.reserve(n);
       f->depth.depth_mm.reserve(n);
       pool.push_back(std::move(f));
@@ -284,8 +284,8 @@ bool Pipeline::start(std::string* why) {
   }
   m.reload.emplace(m.config.tracker);
   const PartForest* forest = m.forest ? &*m.forest : nullptr;
-  m.preprocess.emplace(m.config.tracker, *m.reload, m.hint, forest, m.tally, m.watch);
-  m.optimize.emplace(m.config.tracker, *m.reload, m.hint, m.watch);
+  m.preprocess.emplace(m.config.tracker, *m.reload, m.request, forest, m.tally, m.watch);
+  m.optimize.emplace(m.config.tracker, *m.reload, m.request, m.watch);
   m.publish.emplace(m.ring, m.tally, m.watch, m.stats);
   m.allocate_pool();
 

@@ -7,9 +7,9 @@
 
 namespace handtrack::daemon {
 
-PreprocessStage::PreprocessStage(const TrackerConfig& config, TrackerReload& reload, const HintMailbox& hint,
+PreprocessStage::PreprocessStage(const TrackerConfig& config, TrackerReload& reload, const RequestMailbox& request,
                                  const PartForest* forest, PipelineTally& tally, StageWatch& watch)
-    : reload_(reload), hint_(hint), forest_(forest), tally_(tally), watch_(watch), input_config_(config.input) {}
+    : reload_(reload), request_(request), forest_(forest), tally_(tally), watch_(watch), input_config_(config.input) {}
 
 void PreprocessStage::apply_reload() {
   if (const auto g = reload_.generation(); g != input_generation_) {
@@ -22,11 +22,11 @@ void PreprocessStage::step(Frame& f) {
   f.preprocess_start_ns = monotonic_ns();
   watch_.busy(Stage::kPreprocess, f.seq, f.preprocess_start_ns);
   apply_reload();
-  if (f.builder_generation != input_generation_) {
-    f.builder = DepthInputBuilder(input_config_);  // SIGHUP only: allocates
-    f.builder_generation = input_generation_;
+  if (f.inputs_generation != input_generation_) {
+    f.inputs = TrackerInputs(input_config_);  // SIGHUP only: allocates
+    f.inputs_generation = input_generation_;
   }
-  f.input = nullptr;
+  f.has_input = false;
   f.empty = false;
   f.malformed = false;
   f.resolution_changed = false;
@@ -51,7 +51,8 @@ void PreprocessStage::step(Frame& f) {
     if (in_volume == 0) {
       f.empty = true;
     } else {
-      f.input = &f.builder.build(f.depth, hint_.get(), forest_);
+      f.inputs.build(f.depth, request_.get(), forest_);
+      f.has_input = true;
     }
   }
   f.preprocess_end_ns = monotonic_ns();

@@ -1,7 +1,7 @@
 #pragma once
 // PreprocessStage: raw depth -> C_I (paper Sec. 3.1, 4.3): depth to mm, the working-volume test,
-// then the frame's DepthInputBuilder (median filter, segmentation guided by the last pose's hint,
-// quadtree Gaussians, part labels when a forest is loaded). Frames whose buffer does not match
+// then the frame's TrackerInputs for the hands the tracker asked for (median filter, segmentation
+// guided by the last pose's hint, quadtree Gaussians, part labels when a forest is loaded). Frames whose buffer does not match
 // their intrinsics are marked malformed (skipped and counted at publish); frames with no depth in
 // the working volume are marked empty (published as no_hand). The first frame of a new resolution
 // is marked so that the optimizer restarts.
@@ -19,18 +19,18 @@ namespace handtrack::daemon {
 class PreprocessStage {
  public:
   // `forest` may be null (depth-only); it outlives the stage.
-  PreprocessStage(const TrackerConfig& config, TrackerReload& reload, const HintMailbox& hint,
+  PreprocessStage(const TrackerConfig& config, TrackerReload& reload, const RequestMailbox& request,
                   const PartForest* forest, PipelineTally& tally, StageWatch& watch);
 
-  // A builder for a new pool frame, for the configuration in force.
-  [[nodiscard]] DepthInputBuilder make_builder() const { return DepthInputBuilder(input_config_); }
+  // Inputs for a new pool frame, for the configuration in force.
+  [[nodiscard]] TrackerInputs make_inputs() const { return TrackerInputs(input_config_); }
   void step(Frame& frame);
 
  private:
   void apply_reload();
 
   TrackerReload& reload_;
-  const HintMailbox& hint_;
+  const RequestMailbox& request_;
   const PartForest* forest_;
   PipelineTally& tally_;
   StageWatch& watch_;

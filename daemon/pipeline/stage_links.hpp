@@ -1,6 +1,7 @@
 #pragma once
-// What flows between stages besides frames: the segmentation hint (optimize -> preprocess) and a
-// reloaded tracker configuration (control thread -> preprocess and optimize).
+// What flows between stages besides frames: what the next frame's preprocessing should build
+// (optimize -> preprocess) and a reloaded tracker configuration (control thread -> preprocess and
+// optimize).
 //
 // Thread roles: thread-safe (a mutex each; taken once per frame, never contended for long).
 #include "handtrack/core/tracker.hpp"
@@ -12,23 +13,24 @@
 
 namespace handtrack::daemon {
 
-// The hint for segmentation from the last optimized pose: optimize writes after every frame,
-// preprocess reads before every frame. A frame preprocessed while the previous one is still being
-// optimized uses the hint of the one before: that lag of one frame is the price of the overlap.
-class HintMailbox {
+// The tracker's request for the next frame (Tracker::request(): which hands, and the segmentation
+// hints from the last optimized pose): optimize writes after every frame, preprocess reads before
+// every frame. A frame preprocessed while the previous one is still being optimized uses the
+// request of the one before: that lag of one frame is the price of the overlap.
+class RequestMailbox {
  public:
-  void put(const std::optional<HandHint>& hint) {
+  void put(const InputRequest& request) {
     std::lock_guard lock(mutex_);
-    hint_ = hint;
+    request_ = request;
   }
-  [[nodiscard]] std::optional<HandHint> get() const {
+  [[nodiscard]] InputRequest get() const {
     std::lock_guard lock(mutex_);
-    return hint_;
+    return request_;
   }
 
  private:
   mutable std::mutex mutex_;
-  std::optional<HandHint> hint_;
+  InputRequest request_;
 };
 
 // SIGHUP: the control thread posts a new tracker configuration; each stage that depends on it

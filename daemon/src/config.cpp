@@ -25,8 +25,13 @@ using Uint64Ref = uint64_t& (*)(DaemonConfig&);
 using DoubleRef = double& (*)(DaemonConfig&);
 using BoolRef = bool& (*)(DaemonConfig&);
 using StringRef = std::string& (*)(DaemonConfig&);
-using LevelRef = LogLevel& (*)(DaemonConfig&);
-using Ref = std::variant<IntRef, Int64Ref, Uint64Ref, DoubleRef, BoolRef, StringRef, LevelRef>;
+// A field that takes one of a few names (the log level, the handedness).
+struct ChoiceRef {
+  const char* (*get)(DaemonConfig&);
+  bool (*set)(DaemonConfig&, const std::string&);  // false: not one of `allowed`
+  const char* allowed;                             // "a, b, c"
+};
+using Ref = std::variant<IntRef, Int64Ref, Uint64Ref, DoubleRef, BoolRef, StringRef, ChoiceRef>;
 
 struct Field {
   const char* name;  // dotted TOML path
@@ -56,8 +61,11 @@ const std::vector<Field>& fields() {
      "POSIX shared-memory object name of the pose ring (no '/')", false},
     {"daemon.ring_capacity", IntRef{[](DaemonConfig& c) -> int& { return c.ring_capacity; }}, 2, 65536,
      "pose records kept in the ring", false},
-    {"daemon.log_level", LevelRef{[](DaemonConfig& c) -> LogLevel& { return c.log_level; }}, 0, 0,
-     "trace | debug | info | warn | error | off", true},
+    {"daemon.log_level",
+     ChoiceRef{[](DaemonConfig& c) { return to_string(c.log_level); },
+               [](DaemonConfig& c, const std::string& v) { return parse_log_level(v, &c.log_level); },
+               "trace, debug, info, warn, error, off"},
+     0, 0, "trace | debug | info | warn | error | off", true},
     {"daemon.fast", BoolRef{[](DaemonConfig& c) -> bool& { return c.fast; }}, 0, 0,
      "recordings and the synthetic camera: as fast as possible instead of at their frame rate", false},
     {"daemon.loop", BoolRef{[](DaemonConfig& c) -> bool& { return c.loop; }}, 0, 0,
@@ -104,6 +112,12 @@ const std::vector<Field>& fields() {
      "mean of alpha in P_i = Theta^{t-1} + alpha (Theta^{t-1} - Theta^{t-2}) (Sec. 5)", true},
     {"tracker.extrapolation_sigma", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.extrapolation_sigma; }}, 0, 5,
      "standard deviation of alpha (Sec. 5)", true},
+    {"tracker.handedness",
+     ChoiceRef{[](DaemonConfig& c) { return to_string(c.tracker.handedness); },
+               [](DaemonConfig& c, const std::string& v) { return parse_handedness_mode(v, &c.tracker.handedness); },
+               "auto, left, right"},
+     0, 0, "auto | left | right: which hand the tracker fits (auto: both at every (re)start, the better kept)",
+     true},
     {"tracker.init_iterations", IntRef{[](DaemonConfig& c) -> int& { return c.tracker.init_iterations; }}, 1, 1000,
      "iterations of a (re)start from the open or closed hand", true},
     {"tracker.lost_confidence", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.lost_confidence; }}, 0, 1,
@@ -214,8 +228,8 @@ std::string range_text(const Field& f) {
           return fmt::format("allowed range {}..{}", static_cast<int64_t>(f.min), static_cast<int64_t>(f.max));
         } else if constexpr (std::is_same_v<T, BoolRef>) {
           return "allowed: true or false";
-        } else if constexpr (std::is_same_v<T, LevelRef>) {
-          return "allowed: trace, debug, info, warn, error, off";
+        } else if constexpr (std::is_same_v<T, ChoiceRef>) {
+          return std::string("allowed: ") + ref.allowed;
         } else {
           return fmt::format("allowed: a string of {} to {} characters", static_cast<int64_t>(f.min),
                              static_cast<int64_t>(f.max));
@@ -239,8 +253,8 @@ std::string value_text(const Field& f, DaemonConfig& c) {
           return ref(c) ? "true" : "false";
         } else if constexpr (std::is_same_v<T, StringRef>) {
           return toml_quote(ref(c));
-        } else if constexpr (std::is_same_v<T, LevelRef>) {
-          return fmt::format("\"{}\"", to_string(ref(c)));
+        } else if constexpr (std::is_same_v<T, ChoiceRef>) {
+          return fmt::format("\"{}\"", ref.get(c));
         } else {
           return fmt::format("{}", ref(c));
         }
@@ -306,9 +320,9 @@ void apply_node(DaemonConfig& c, const Field& f, const toml::node& node, const s
           auto v = node.value_exact<std::string>();
           if (!v) fail(origin, fmt::format("{} must be a string", name));
           ref(c) = *v;
-        } else if constexpr (std::is_same_v<T, LevelRef>) {
+        } else if constexpr (std::is_same_v<T, ChoiceRef>) {
           auto v = node.value_exact<std::string>();
-          if (!v || !parse_log_level(*v, &ref(c))) {
+          if (!v || !ref.set(c, *v)) {
             fail(origin, fmt::format("{} = {}: {}", name, v ? toml_quote(*v) : std::string("(not a string)"),
                                      range_text(f)));
           }
@@ -362,7 +376,7 @@ void validate(const DaemonConfig& config, const std::string& origin) {
     std::visit(
         [&](auto ref) {
           using T = decltype(ref);
-          if constexpr (std::is_same_v<T, BoolRef> || std::is_same_v<T, LevelRef>) {
+          if constexpr (std::is_same_v<T, BoolRef> || std::is_same_v<T, ChoiceRef>) {
             return;
           } else if constexpr (std::is_same_v<T, StringRef>) {
             const auto n = static_cast<double>(ref(c).size());
@@ -442,7 +456,7 @@ std::string describe_config(const DaemonConfig& config) {
       table = t;
     }
     // Strings and the log level explain their values in the help text already.
-    const bool own_range = std::holds_alternative<StringRef>(f.ref) || std::holds_alternative<LevelRef>(f.ref) ||
+    const bool own_range = std::holds_alternative<StringRef>(f.ref) || std::holds_alternative<ChoiceRef>(f.ref) ||
                            std::holds_alternative<BoolRef>(f.ref);
     out += fmt::format("# {}{}{}\n{} = {}\n", f.help, own_range ? "" : " (" + range_text(f) + ")",
                        f.live ? " [live]" : "", name.substr(dot + 1), value_text(f, c));

@@ -36,7 +36,7 @@ HandRun track_synthetic(const std::string& motion, synth::Handedness hand, uint6
   options.seed = seed;
   options.hand = hand;
   synth::SyntheticCamera camera(options);
-  Tracker tracker(TrackerConfig{}, HandednessMode::kAuto);
+  Tracker tracker(TrackerConfig{});
   const Handedness shown = hand == synth::Handedness::kLeft ? Handedness::kLeft : Handedness::kRight;
   HandRun run;
   double sum = 0.0;
@@ -99,8 +99,8 @@ TEST(RealHands, Sr305FramesAreRightHandsAndTheirMirrorImagesTheOtherHand) {
       const auto row = mirrored.depth_mm.begin() + static_cast<std::ptrdiff_t>(v) * cam.width;
       std::reverse(row, row + cam.width);
     }
-    Tracker as_seen(config, HandednessMode::kAuto);
-    Tracker as_mirrored(config, HandednessMode::kAuto);
+    Tracker as_seen(config);
+    Tracker as_mirrored(config);
     const TrackerOutput right = as_seen.track(depth);
     const TrackerOutput left = as_mirrored.track(mirrored);
     const std::string name = entry.path().filename().string();

@@ -122,6 +122,7 @@ int main(int argc, char** argv) {
                                "--energy late-fusion needs --forest MODEL (handtrack-train-forest) or --oracle-labels", 1);
   }
   if (energy == "late-fusion") config.mode = EnergyMode::kLateFusion;
+  parse_handedness_mode(hand, &config.handedness);  // one of the names CLI11 checked
   if (sim_only) config.weights.collision = config.weights.limits = config.weights.smoothness = 0.0;
 
   try {
@@ -157,10 +158,7 @@ int main(int argc, char** argv) {
     tools::Progress progress(kProgram);
     size_t done = 0;
     for (const auto& reader : readers) {
-      const HandednessMode mode = hand == "auto" ? HandednessMode::kAuto
-                                  : hand == "left" ? HandednessMode::kLeft
-                                                   : HandednessMode::kRight;
-      Tracker tracker(config, mode);
+      Tracker tracker(config);
       eval::SequenceScorer scorer(sequence_name(reader.dir()), read_hand_json(reader.dir()));
       double seconds = 0.0;
       for (size_t i = 0; i < reader.frame_count(); ++i) {

@@ -123,7 +123,7 @@ int run_sequence(const Args& a) {
     const bool annotated = std::any_of(tips.begin(), tips.end(), [](const auto& t) { return t.has_value(); });
     handtrack::view::FrameView view;
     view.depth = &depth;
-    view.input = &tracker.last_input();
+    view.input = tracker.last_input();
     view.output = &output;
     view.model = &tracker.pose_tracker().model();
     view.labels = labels ? &*labels : nullptr;
@@ -187,7 +187,7 @@ int run_single(const Args& a) {
   const handtrack::TrackerOutput output = tracker.track(depth);
   handtrack::view::FrameView view;
   view.depth = &depth;
-  view.input = &tracker.last_input();
+  view.input = tracker.last_input();
   view.output = &output;
   view.model = &tracker.pose_tracker().model();
   view.labels = labels ? &*labels : nullptr;

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <optional>
 #include <random>
+#include <string>
 
 namespace handtrack {
 
@@ -29,6 +30,8 @@ enum class Handedness : uint8_t { kRight = 0, kLeft = 1 };
 const char* to_string(Handedness hand);  // "right", "left"
 // Which hands a Tracker considers: one, or both (chosen at every (re)start by the better fit).
 enum class HandednessMode : uint8_t { kRight, kLeft, kAuto };
+const char* to_string(HandednessMode mode);  // "right", "left", "auto"
+bool parse_handedness_mode(const std::string& text, HandednessMode* mode);
 
 // Which energies the particles optimise (Sec. 5).
 enum class EnergyMode {
@@ -48,6 +51,7 @@ const char* to_string(EnergyMode mode);
 
 struct TrackerConfig {
   EnergyMode mode = EnergyMode::kDepthOnly;
+  HandednessMode handedness = HandednessMode::kAuto;  // Tracker only (a PoseTracker is one hand)
   DepthInputConfig input;
   EnergyWeights weights;
   OptimizerConfig optimizer;
@@ -73,6 +77,12 @@ struct TrackerConfig {
   int check_interval_frames = 5;
   // A (re)start must explain at least this much of the segmented surface, or there is no hand.
   double min_start_confidence = 0.6;
+  // Auto handedness (Tracker; ours): a hand chosen by less than this confidence margin is not
+  // settled (a fist, a flat hand seen edge-on: both hands explain it), and the other hand is fitted
+  // again from its (re)start every `handedness_check_frames` frames until one wins by the margin.
+  // Every suspect-confidence check (above) also fits the other hand.
+  double handedness_margin = 0.05;
+  int handedness_check_frames = 30;
   uint64_t seed = 1;
 };
 
@@ -118,10 +128,10 @@ class PoseTracker {
   [[nodiscard]] const HandModel& model() const { return model_; }
   [[nodiscard]] const TrackerConfig& config() const { return config_; }
   void set_scale(const HandScale& scale);
-  // Open (or closed) hand placed at the segmented hand of `input` (Sec. 5's start pose), turned by
-  // `in_plane_offset_rad` about the camera axis.
+  // Open (or closed) hand placed at the segmented hand of `input` (Sec. 5's start pose), palm (or
+  // back) toward the camera, turned by `in_plane_offset_rad` about the camera axis.
   [[nodiscard]] PoseParams initial_pose(const DepthInput& input, double in_plane_offset_rad = 0.0,
-                                        bool closed = false) const;
+                                        bool closed = false, bool back = false) const;
   // How much of the segmented hand the posed model explains, in [0, 1].
   [[nodiscard]] double confidence(const DepthInput& input, const PosedHand& hand) const;
 
@@ -160,47 +170,91 @@ class PoseTracker {
   int frames_since_check_ = 0;
 };
 
-// preprocess + optimise on one thread: what handtrack-eval and the single-threaded path use.
-// Depth image -> pose, for one hand at a time: the preprocessing (DepthInputBuilder) and the
-// optimiser (PoseTracker) of one hand, and the choice of hand.
+// What the next frame's preprocessing should build for a Tracker: the inputs of the hands it will
+// fit, each with its segmentation hint (the mirrored frame's hint for the left hand).
+struct InputRequest {
+  bool right = true;
+  bool left = false;
+  std::optional<HandHint> right_hint;
+  std::optional<HandHint> left_hint;
+};
+
+// One frame's preprocessed inputs, for the hands an InputRequest asked for: the right hand's from
+// the frame, the left hand's from its mirror image (see Tracker). Storage is reused between
+// frames; a pipeline keeps one per frame in flight, so frame t+1 is preprocessed while frame t is
+// optimised.
+class TrackerInputs {
+ public:
+  explicit TrackerInputs(const DepthInputConfig& config = {});
+  void build(const DepthImage& depth, const InputRequest& request, const PixelLabeller* labeller = nullptr);
+  // Null when not built for this frame.
+  [[nodiscard]] const DepthInput* get(Handedness hand) const {
+    if (hand == Handedness::kLeft) return has_left_ ? &left_.last() : nullptr;
+    return has_right_ ? &right_.last() : nullptr;
+  }
+
+ private:
+  DepthInputBuilder right_;
+  DepthInputBuilder left_;
+  DepthImage mirrored_;
+  bool has_right_ = false;
+  bool has_left_ = false;
+};
+
+// Depth image -> pose, for one hand at a time: the optimisers (PoseTracker) of either hand and the
+// choice of hand; the preprocessing is TrackerInputs, which a pipeline runs on another thread.
 //
 // A left hand is the mirror image of a right hand about the camera's x = 0 plane, which the camera
 // sees exactly as the image flipped left to right with the principal point at
 // u = (width - 1) - cx (pixel centres at integer u). So a left hand is tracked as the right hand of
-// the mirrored image, by a second builder and tracker that only ever see mirrored images, and its
-// joints, fingertips, palm centre and normal are mirrored back (x negated); `params` stay those of
-// the right-hand model in the mirrored image. With HandednessMode::kAuto both hands are fitted at
+// the mirrored image, by a second PoseTracker that only ever sees mirrored inputs, and its joints,
+// fingertips, palm centre and normal are mirrored back (x negated); `params` stay those of the
+// right-hand model in the mirrored image. With HandednessMode::kAuto both hands are fitted at
 // every (re)start (no hand yet, lost, recovering) and the one that explains more of the hand
-// (confidence) is kept; while it tracks, only it runs.
+// (confidence) is kept; while it tracks, only it runs, except on checks: the tracked hand then
+// competes with the other hand's (re)start, which replaces it when it explains more. A check
+// comes with every suspect fit (PoseTracker's gross-error check) and, while the last choice was
+// not clear (TrackerConfig::handedness_margin), every handedness_check_frames frames.
+//
+// Threading: request() and optimise() on one thread; TrackerInputs::build() anywhere, on inputs
+// the optimising thread does not read at the time.
 class Tracker {
  public:
-  explicit Tracker(TrackerConfig config = {}, HandednessMode mode = HandednessMode::kRight);
+  explicit Tracker(const TrackerConfig& config = {});
+  // What the next frame needs: both hands at a (re)start in auto mode, else the current one.
+  [[nodiscard]] InputRequest request() const;
+  // Fits the hand(s) on inputs built for request() (or for an older request: a hand whose input
+  // is missing is not fitted; with neither, the frame has no hand).
+  TrackerOutput optimise(const TrackerInputs& inputs);
+  // Both steps on this thread: what handtrack-eval and the single-threaded path use.
   TrackerOutput track(const DepthImage& depth, const PixelLabeller* labeller = nullptr);
-  // The current hand's last input and tracker (for a left hand: of the mirrored image).
-  [[nodiscard]] const DepthInput& last_input() const { return side(current_).builder.last(); }
-  [[nodiscard]] PoseTracker& pose_tracker() { return side(current_).pose; }
+  // The current hand's input of track()'s last frame and its tracker (for a left hand: of the
+  // mirrored image); the input is null when that hand was not preprocessed.
+  [[nodiscard]] const DepthInput* last_input() const { return inputs_.get(current_); }
+  [[nodiscard]] PoseTracker& pose_tracker() { return side(current_); }
+  [[nodiscard]] const TrackerConfig& config() const { return right_.config(); }
   void reset();
 
  private:
-  struct Side {
-    explicit Side(const TrackerConfig& config) : builder(config.input), pose(config) {}
-    DepthInputBuilder builder;
-    PoseTracker pose;
-  };
-  [[nodiscard]] const Side& side(Handedness hand) const { return hand == Handedness::kLeft ? left_ : right_; }
-  Side& side(Handedness hand) { return hand == Handedness::kLeft ? left_ : right_; }
-  TrackerOutput track_as(Handedness hand, const DepthImage& depth, const PixelLabeller* labeller);
+  [[nodiscard]] const PoseTracker& side(Handedness hand) const { return hand == Handedness::kLeft ? left_ : right_; }
+  PoseTracker& side(Handedness hand) { return hand == Handedness::kLeft ? left_ : right_; }
+  // Both hands this frame: a (re)start, a check of an unsettled choice, or a suspect fit.
+  [[nodiscard]] bool both() const;
+  // Whether hand `a` is the better fit of the frame than hand `b`.
+  [[nodiscard]] bool prefer(const TrackerOutput& a, const TrackerOutput& b) const;
+  TrackerOutput fit(Handedness hand, const DepthInput& input);
   void identify(TrackerOutput& out);  // sets out.hand_id
 
-  HandednessMode mode_;
-  Side right_;
-  Side left_;
+  PoseTracker right_;
+  PoseTracker left_;
+  TrackerInputs inputs_;  // track()'s
   Handedness current_ = Handedness::kRight;
   double handedness_confidence_ = 1.0;
+  bool settled_ = true;                // the last choice of hand was clear (handedness_margin)
+  int frames_since_hand_check_ = 0;
   bool tracking_ = false;  // the current hand tracked in the last frame
   uint32_t hand_id_ = 0;   // of the hand in view; 0: none in the last frame
   uint32_t last_hand_id_ = 0;
-  DepthImage mirrored_;    // scratch: the mirrored frame for the left hand
 };
 
 }  // namespace handtrack
