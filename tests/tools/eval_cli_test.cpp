@@ -1,6 +1,10 @@
 // handtrack-eval on sequences it cannot score (issue 13): one clear line and a failing exit code,
-// never a table of `nan`s with exit 0.
+// never a table of `nan`s with exit 0. And the benchmark's groups: sequences pooled by the view,
+// motion and hand their hand.json names, frames without a pose counted as misses.
 #include "handtrack/core/sequence.hpp"
+#include "handtrack/synth/synthetic_camera.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <gtest/gtest.h>
 
@@ -36,11 +40,13 @@ class EvalCli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  // Runs handtrack-eval on the sequence; returns the exit code, stderr in *err.
-  int eval(std::string* err) const {
+  // Runs handtrack-eval on the sequences (default: the empty one); returns the exit code, stderr in
+  // *err.
+  int eval(std::string* err, const std::string& args = "") const {
     const fs::path out = dir_ / "stdout.txt", errf = dir_ / "stderr.txt";
-    const std::string cmd = std::string("'") + HANDTRACK_EVAL_EXE + "' '" + (dir_ / "seq").string() + "' >'" +
-                            out.string() + "' 2>'" + errf.string() + "' </dev/null";
+    const std::string cmd = std::string("'") + HANDTRACK_EVAL_EXE + "' " +
+                            (args.empty() ? "'" + (dir_ / "seq").string() + "'" : args) + " >'" + out.string() +
+                            "' 2>'" + errf.string() + "' </dev/null";
     const int status = std::system(cmd.c_str());
     std::ifstream in(errf);
     std::stringstream text;
@@ -67,6 +73,47 @@ TEST_F(EvalCli, AnEmptyGroundTruthFileIsNotCalledMissing) {
   fs::remove(dir_ / "seq" / "groundtruth.csv");
   EXPECT_NE(eval(&err), 0);
   EXPECT_NE(err.find("no groundtruth.csv"), std::string::npos) << err;
+}
+
+// Two rendered sequences and the empty one, each with a hand.json naming its view and motion: the
+// JSON pools them per view, motion and hand, and the empty one's frames are all misses.
+TEST_F(EvalCli, GroupsSequencesByTheViewMotionAndHandTheirHandJsonNames) {
+  const auto describe = [](const fs::path& seq, const std::string& hand, const std::string& view,
+                           const std::string& motion) {
+    std::ofstream(seq / "hand.json") << nlohmann::json{{"hands", {hand}}, {"view", view}, {"motion", motion}}.dump();
+  };
+  for (const char* motion : {"pinch", "adbadd"}) {
+    handtrack::synth::SynthOptions o;
+    o.motion = motion;
+    o.frames = 6;
+    handtrack::synth::SyntheticCamera cam(o);
+    handtrack::SequenceWriter writer(dir_ / motion, cam.camera());
+    for (int f = 0; f < o.frames; ++f) {
+      const auto frame = cam.render(f);
+      writer.write_depth(f, frame.depth);
+      writer.write_fingertips(f, frame.fingertips);
+    }
+    writer.flush();
+    describe(dir_ / motion, "right", "palm", motion);
+  }
+  describe(dir_ / "seq", "left", "head-mounted", "pinch");
+  const fs::path json = dir_ / "eval.json";
+  std::string err;
+  ASSERT_EQ(eval(&err, "'" + (dir_ / "pinch").string() + "' '" + (dir_ / "adbadd").string() + "' '" +
+                           (dir_ / "seq").string() + "' --json '" + json.string() + "'"),
+            0)
+      << err;
+  std::ifstream in(json);
+  const auto j = nlohmann::json::parse(in);
+  const auto& g = j.at("groups");
+  EXPECT_EQ(g.at("view").at("palm").at("frames").get<int>(), 12);
+  EXPECT_EQ(g.at("view").at("head-mounted").at("frames_without_pose").get<int>(), 4);
+  EXPECT_DOUBLE_EQ(g.at("view").at("head-mounted").at("pct_frames_without_pose").get<double>(), 100.0);
+  EXPECT_EQ(g.at("motion").at("pinch").at("frames").get<int>(), 10);
+  EXPECT_EQ(g.at("hand").at("left").at("frames").get<int>(), 4);
+  EXPECT_LT(g.at("view").at("palm").at("mean_fingertip_error_mm").get<double>(), 30.0);
+  EXPECT_EQ(j.at("sequences").at(2).at("view"), "head-mounted");
+  EXPECT_DOUBLE_EQ(j.at("overall").at("pct_frames_without_pose").get<double>(), 100.0 * 4 / 16);
 }
 
 }  // namespace

@@ -30,20 +30,37 @@ std::string sequence_name(const fs::path& dir) {
   return name.empty() ? fs::path(dir).lexically_normal().parent_path().filename().string() : name;
 }
 
-// SPEC.md "Sequence directory": DIR/hand.json {"hands":["left"]} says which hand a sequence shows
-// (absent: unknown). Anything else in it is an error naming the file.
-std::optional<Handedness> read_hand_json(const fs::path& dir) {
+// What a sequence's hand.json says (SPEC.md "Sequence directory"): {"hands":["left"]}, which hand
+// it shows, and, from handtrack-synth, "view" and "motion" (strings). Absent file: nothing known.
+// Anything else in it is an error naming the file.
+struct SequenceInfo {
+  std::optional<Handedness> hand;
+  std::string view;
+  std::string motion;
+};
+
+SequenceInfo read_sequence_info(const fs::path& dir) {
   const fs::path file = dir / "hand.json";
-  if (!fs::exists(file)) return std::nullopt;
+  SequenceInfo info;
+  if (!fs::exists(file)) return info;
   std::ifstream in(file);
   const auto j = nlohmann::json::parse(in, nullptr, false);
+  const auto optional_string = [&](const char* key, std::string& out) {
+    if (!j.contains(key)) return true;
+    if (!j[key].is_string()) return false;
+    out = j[key].get<std::string>();
+    return true;
+  };
   if (j.is_object() && j.contains("hands") && j["hands"].is_array() && j["hands"].size() == 1 &&
-      j["hands"][0].is_string()) {
+      j["hands"][0].is_string() && optional_string("view", info.view) && optional_string("motion", info.motion)) {
     const auto hand = j["hands"][0].get<std::string>();
-    if (hand == "left") return Handedness::kLeft;
-    if (hand == "right") return Handedness::kRight;
+    if (hand == "left") info.hand = Handedness::kLeft;
+    if (hand == "right") info.hand = Handedness::kRight;
+    if (info.hand) return info;
   }
-  throw std::runtime_error(file.string() + ": expected {\"hands\":[\"left\"]} or {\"hands\":[\"right\"]}");
+  throw std::runtime_error(file.string() +
+                           ": expected {\"hands\":[\"left\"]} or {\"hands\":[\"right\"]}, with optional string "
+                           "\"view\" and \"motion\"");
 }
 
 // --tips-csv: one row per frame with the estimated and the true fingertips.
@@ -159,7 +176,8 @@ int main(int argc, char** argv) {
     size_t done = 0;
     for (const auto& reader : readers) {
       Tracker tracker(config);
-      eval::SequenceScorer scorer(sequence_name(reader.dir()), read_hand_json(reader.dir()));
+      const SequenceInfo info = read_sequence_info(reader.dir());
+      eval::SequenceScorer scorer(sequence_name(reader.dir()), info.hand);
       double seconds = 0.0;
       for (size_t i = 0; i < reader.frame_count(); ++i) {
         const DepthImage depth = reader.depth(i);
@@ -175,6 +193,8 @@ int main(int argc, char** argv) {
         progress.update(sequence_name(reader.dir()), static_cast<double>(++done) / static_cast<double>(total_frames));
       }
       scores.push_back(scorer.finish(seconds));
+      scores.back().view = info.view;
+      scores.back().motion = info.motion;
     }
     const auto total = eval::overall(scores);
     // A mean over no frame is not a result: every annotated frame got no pose (or a NaN one).
@@ -182,7 +202,8 @@ int main(int argc, char** argv) {
       throw std::runtime_error("no frame could be scored: the tracker reported no hand in all " +
                                std::to_string(total.frames) + " frames with ground truth");
     }
-    const auto json = eval::to_json(scores, total);
+    const auto groups = eval::group_scores(scores);
+    const auto json = eval::to_json(scores, total, groups);
     if (!json_file.empty()) {
       std::ofstream out(json_file);
       if (!out) throw std::runtime_error(json_file + ": cannot write");
@@ -202,7 +223,7 @@ int main(int argc, char** argv) {
       draw::write_error_plot(plot_file, series);
     }
     // A human-readable table on stdout: the paper's Table 1 in our numbers.
-    std::fputs(eval::format_table(scores, total).c_str(), stdout);
+    std::fputs(eval::format_table(scores, total, groups).c_str(), stdout);
   } catch (const std::exception& e) {
     return report_error(kProgram, e.what(), 1);
   }

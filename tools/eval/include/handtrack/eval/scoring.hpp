@@ -40,7 +40,19 @@ struct SequenceScore {
   int hand_known_frames = 0;  // posed frames of sequences that say their hand
   int hand_correct = 0;
   std::vector<double> per_frame_error_mm;  // NaN = not annotated, inf = no pose
+  // What the sequence's hand.json says besides its hand ("" where it does not): the camera
+  // arrangement (handtrack-synth --view) and the motion; the benchmark's groups.
+  std::string view;
+  std::string motion;
 };
+
+// Sequences pooled by a property (overall() of each group), e.g. "view" -> {"back": ..., "palm": ...}.
+struct ScoreGroups {
+  std::string by;  // "motion", "view" or "hand"
+  std::vector<SequenceScore> groups;  // name = the property's value
+};
+// The groups by motion, view and hand, each only where at least one sequence says its value.
+std::vector<ScoreGroups> group_scores(const std::vector<SequenceScore>& sequences);
 
 // Accumulates one sequence's frames.
 class SequenceScorer {
@@ -60,9 +72,13 @@ class SequenceScorer {
 SequenceScore overall(const std::vector<SequenceScore>& sequences);
 
 // The paper's Table 1 in our numbers: one row per sequence and the overall row, as text.
-std::string format_table(const std::vector<SequenceScore>& sequences, const SequenceScore& total);
+// Then, one block per grouping: "by view", one row per view, and so on.
+std::string format_table(const std::vector<SequenceScore>& sequences, const SequenceScore& total,
+                         const std::vector<ScoreGroups>& groups = {});
 
 // SPEC.md "Evaluation output".
-nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const SequenceScore& total);
+// SPEC.md "Evaluation output", and "groups": {"view": {"back": {...}, ...}, "hand": {...}}.
+nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const SequenceScore& total,
+                       const std::vector<ScoreGroups>& groups = {});
 
 }  // namespace handtrack::eval
