@@ -1,10 +1,11 @@
 #include "handtrack/core/tracker.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
-#include <Eigen/Geometry>
 
 namespace handtrack {
 
@@ -246,7 +247,7 @@ std::optional<HandHint> PoseTracker::hint() const {
 }
 
 PoseParams PoseTracker::initial_pose(const DepthInput& input, double in_plane_offset_rad, bool closed,
-                                      bool back) const {
+                                     bool back) const {
   // Frontal open hand (r = 0: fingers toward -y in the image) turned in the image plane onto the
   // hand's axis: rotation phi about the camera z maps (0,-1) to (sin phi, -cos phi). The back of
   // the hand faces the camera after half a turn about the finger axis (the camera y axis at r = 0)

@@ -43,12 +43,17 @@ synth::HandPose random_pose(synth::Rng& rng, const synth::HandShape& shape, cons
     }
   }
   // Global rotation: roll about the viewing axis, then pitch and yaw out of the image plane, applied
-  // to the rest orientation (palm toward the camera, fingers up): camera_R_hand = M R0.
-  const Eigen::Matrix3d m =
-      (Eigen::AngleAxisd(deg(rng.uniform(-options.max_roll_deg, options.max_roll_deg)), Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(deg(rng.uniform(-options.max_pitch_deg, options.max_pitch_deg)), Eigen::Vector3d::UnitX()) *
-       Eigen::AngleAxisd(deg(rng.uniform(-options.max_yaw_deg, options.max_yaw_deg)), Eigen::Vector3d::UnitY()))
-          .toRotationMatrix();
+  // to the rest orientation (palm toward the camera, fingers up): camera_R_hand = M R0. Yaw turns
+  // the hand about its finger axis (180 deg: the back toward the camera), pitch tips the fingers
+  // toward or away from the camera.
+  const bool turned = rng.uniform() < options.turned_fraction;
+  const double max_roll = turned ? 180.0 : options.max_roll_deg;
+  const double max_pitch = turned ? kMaxTurnedPitchDeg : options.max_pitch_deg;
+  const double max_yaw = turned ? 180.0 : options.max_yaw_deg;
+  const Eigen::Matrix3d m = (Eigen::AngleAxisd(deg(rng.uniform(-max_roll, max_roll)), Eigen::Vector3d::UnitZ()) *
+                             Eigen::AngleAxisd(deg(rng.uniform(-max_pitch, max_pitch)), Eigen::Vector3d::UnitX()) *
+                             Eigen::AngleAxisd(deg(rng.uniform(-max_yaw, max_yaw)), Eigen::Vector3d::UnitY()))
+                                .toRotationMatrix();
   const Eigen::AngleAxisd aa(m);
   pose.rotation = aa.angle() * aa.axis();
   // Palm centre at a random depth and image position; t is the wrist: t = p - R palm_centre_hand.

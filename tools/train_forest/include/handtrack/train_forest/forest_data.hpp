@@ -41,6 +41,10 @@ struct SceneOptions {
   double max_roll_deg = 90.0;       // random poses: rotation about the camera's viewing axis
   double max_pitch_deg = 50.0;      // ... about the camera x axis (tilt toward / away)
   double max_yaw_deg = 60.0;        // ... about the camera y axis
+  // Share of the random poses turned any way instead (issue "Every hand, every view"): the back or
+  // a side toward the camera (yaw up to 180 deg), fingers toward or away from it (pitch up to
+  // kMaxTurnedPitchDeg), any roll.
+  double turned_fraction = 0.5;
   CameraIntrinsics camera = synth::default_camera();
 };
 
@@ -53,6 +57,8 @@ struct Scene {
 
 // The scene of image `index` of the data set `seed` (deterministic).
 Scene make_scene(uint64_t seed, uint64_t index, const SceneOptions& options);
+inline constexpr double kMaxTurnedPitchDeg = 80.0;
+
 // A random pose within the joint limits, placed and rotated as `options` says.
 synth::HandPose random_pose(synth::Rng& rng, const synth::HandShape& shape, const SceneOptions& options);
 
