@@ -62,6 +62,21 @@ void chamfer_distance(std::vector<int>& d, int w, int h) {
   }
 }
 
+// Whether a 4-neighbour of pixel (u, v) has a measured depth nearer than the working volume: the
+// surface leaves the volume toward the camera there.
+bool beside_near_plane(const DepthInputConfig& config, const std::vector<float>& unclamped_mm, int w, int h, int u,
+                       int v) {
+  const auto near = static_cast<float>(config.near_mm);
+  for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+    const int uu = u + du;
+    const int vv = v + dv;
+    if (uu < 0 || vv < 0 || uu >= w || vv >= h) continue;
+    const float z = unclamped_mm[static_cast<size_t>(vv) * w + uu];
+    if (z > 0.0F && z < near) return true;
+  }
+  return false;
+}
+
 // Pixels checked at once when scanning for depth in the working volume (0 outside it).
 constexpr int kScanChunk = 16;
 
@@ -208,8 +223,9 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
       out.gaussians.clear();
       return;
     }
-    // Principal axis of the blob; the hand is the end that does not leave the image (the arm
-    // does), or, when neither or both do, the end nearer the camera.
+    // Principal axis of the blob; the hand is the end that does not leave the image or the working
+    // volume through its near plane (the arm does: a head-mounted camera sees the forearm come from
+    // below the near plane), or, when neither or both do, the end nearer the camera.
     Vector3d mean = Vector3d::Zero();
     int pixels = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -247,7 +263,10 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
       if (end == nullptr) continue;
       const int u = static_cast<int>(i % w);
       const int v = static_cast<int>(i / w);
-      end->border += (u < kBorderPx || v < kBorderPx || u >= w - kBorderPx || v >= h - kBorderPx) ? 1 : 0;
+      end->border += (u < kBorderPx || v < kBorderPx || u >= w - kBorderPx || v >= h - kBorderPx ||
+                      beside_near_plane(config, unclamped_mm, w, h, u, v))
+                         ? 1
+                         : 0;
       end->depth += d[i];
       ++end->pixels;
     }
@@ -262,7 +281,8 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
     }
     // The palm centre is the hand pixel farthest from the hand's outline (the centre of the largest
     // inscribed disc): the palm is the widest part of a hand, open or closed, and wider than the
-    // forearm. Search within one hand length of the tip.
+    // forearm. Search within one hand length of the tip. (In pixels: weighting by depth, to compare
+    // widths in mm, put the centre on the forearm behind a fist; docs/TRACKER.md "Segmentation".)
     const double length = config.hand_length_mm;
     std::vector<int>& dist = stack_;
     dist.assign(n, 0);

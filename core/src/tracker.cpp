@@ -19,6 +19,10 @@ constexpr std::array<bool, 2> kStartClosed = {false, true};
 // ... each with the palm toward the camera and with the back of the hand toward it (turned half a
 // turn about the hand's finger axis).
 constexpr std::array<bool, 2> kStartBack = {false, true};
+// A hand whose segmented axis points this much toward or away from the camera (|a_z|, the sine of
+// the angle out of the image plane: 30 deg) is also started with its fingers along that axis in 3D:
+// a hand reaching forward under a head-mounted camera, fingers pointing at a desk camera.
+constexpr double kOutOfPlaneAxisMinZ = 0.5;
 // Closed hand: [abd, flex1, flex2, flex3] for the thumb, then for each finger.
 constexpr std::array<double, 4> kClosedThumb = {0.3, 0.6, 0.5, 0.5};
 constexpr std::array<double, 4> kClosedFinger = {0.0, 1.3, 1.5, 0.9};
@@ -246,18 +250,26 @@ std::optional<HandHint> PoseTracker::hint() const {
   return HandHint{t + camera_R_hand * model_.palm_centre(), t, camera_R_hand * Vector3d::UnitY()};
 }
 
-PoseParams PoseTracker::initial_pose(const DepthInput& input, double in_plane_offset_rad, bool closed,
-                                     bool back) const {
+PoseParams PoseTracker::initial_pose(const DepthInput& input, const Start& start) const {
   // Frontal open hand (r = 0: fingers toward -y in the image) turned in the image plane onto the
   // hand's axis: rotation phi about the camera z maps (0,-1) to (sin phi, -cos phi). The back of
   // the hand faces the camera after half a turn about the finger axis (the camera y axis at r = 0)
   // first: R = Rz(phi) Ry(pi).
   const Vector3d& axis = input.finger_axis;
-  const double phi = std::atan2(axis.x(), -axis.y()) + in_plane_offset_rad;
+  const double phi = std::atan2(axis.x(), -axis.y()) + start.in_plane_offset_rad;
   PoseParams params = PoseParams::Zero();
-  const Eigen::Matrix3d turn = Eigen::AngleAxisd(phi, Vector3d::UnitZ()).toRotationMatrix() *
-                               Eigen::AngleAxisd(back ? std::numbers::pi : 0.0, Vector3d::UnitY()).toRotationMatrix();
+  Eigen::Matrix3d turn = Eigen::AngleAxisd(phi, Vector3d::UnitZ()).toRotationMatrix() *
+                         Eigen::AngleAxisd(start.back ? std::numbers::pi : 0.0, Vector3d::UnitY()).toRotationMatrix();
+  if (start.along_axis_3d) {
+    // Then tipped about the camera-frame axis perpendicular to both (the image-plane direction and
+    // the 3D axis) until the fingers run along the 3D axis: the palm (or back) stays as square to
+    // the camera as that allows.
+    const Vector3d in_plane = turn * Vector3d(0, -1, 0);
+    const Vector3d along = (Eigen::AngleAxisd(start.in_plane_offset_rad, Vector3d::UnitZ()) * axis).normalized();
+    turn = Eigen::Quaterniond::FromTwoVectors(in_plane, along).toRotationMatrix() * turn;
+  }
   params.segment<3>(kRotationParam) = rotation_log(turn);
+  const bool closed = start.closed;
   if (closed) {
     for (int f = 0; f < kNumFingers; ++f) {
       for (int d = 0; d < 4; ++d) {
@@ -428,15 +440,20 @@ PoseTracker::Fit PoseTracker::restart(const DepthInput& input) {
   const EnergyFrame frame{&model_, &input, nullptr, nullptr};
   const PoseEnergy& energy = fuses(input) ? guided_energy_ : energy_;
   Fit best;
-  for (bool back : kStartBack) {
-    for (bool closed : kStartClosed) {
-      for (double offset : kStartRotations) {
-        const auto r = optimizer_.maximise(energy, frame, initial_pose(input, offset, closed, back), scratch_,
-                                           config_.init_iterations);
-        scratch_.update(model_, r.params);
-        const double c = confidence(input, scratch_);
-        if (c > best.confidence + 1e-9 || (c > best.confidence - 1e-9 && r.energy > best.result.energy)) {
-          best = Fit{r, c};
+  const bool out_of_plane = std::abs(input.finger_axis.z()) >= kOutOfPlaneAxisMinZ;
+  for (bool along_axis_3d : {false, true}) {
+    if (along_axis_3d && !out_of_plane) continue;
+    for (bool back : kStartBack) {
+      for (bool closed : kStartClosed) {
+        for (double offset : kStartRotations) {
+          const Start start{offset, closed, back, along_axis_3d};
+          const auto r = optimizer_.maximise(energy, frame, initial_pose(input, start), scratch_,
+                                             config_.init_iterations);
+          scratch_.update(model_, r.params);
+          const double c = confidence(input, scratch_);
+          if (c > best.confidence + 1e-9 || (c > best.confidence - 1e-9 && r.energy > best.result.energy)) {
+            best = Fit{r, c};
+          }
         }
       }
     }

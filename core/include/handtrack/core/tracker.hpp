@@ -128,10 +128,14 @@ class PoseTracker {
   [[nodiscard]] const HandModel& model() const { return model_; }
   [[nodiscard]] const TrackerConfig& config() const { return config_; }
   void set_scale(const HandScale& scale);
-  // Open (or closed) hand placed at the segmented hand of `input` (Sec. 5's start pose), palm (or
-  // back) toward the camera, turned by `in_plane_offset_rad` about the camera axis.
-  [[nodiscard]] PoseParams initial_pose(const DepthInput& input, double in_plane_offset_rad = 0.0,
-                                        bool closed = false, bool back = false) const;
+  // One (re)start hypothesis: Sec. 5's open hand, or a closed one, placed at the segmented hand.
+  struct Start {
+    double in_plane_offset_rad = 0.0;  // turned about the camera axis away from the segmented axis
+    bool closed = false;               // a fist instead of the open hand
+    bool back = false;                 // the back of the hand toward the camera instead of the palm
+    bool along_axis_3d = false;        // fingers along the segmented axis in 3D, not in the image plane
+  };
+  [[nodiscard]] PoseParams initial_pose(const DepthInput& input, const Start& start) const;
   // How much of the segmented hand the posed model explains, in [0, 1].
   [[nodiscard]] double confidence(const DepthInput& input, const PosedHand& hand) const;
 
