@@ -20,9 +20,9 @@ constexpr std::array<bool, 2> kStartClosed = {false, true};
 // turn about the hand's finger axis).
 constexpr std::array<bool, 2> kStartBack = {false, true};
 // A hand whose segmented axis points this much toward or away from the camera (|a_z|, the sine of
-// the angle out of the image plane: 30 deg) is also started with its fingers along that axis in 3D:
+// the angle out of the image plane: 45 deg) is also started with its fingers along that axis in 3D:
 // a hand reaching forward under a head-mounted camera, fingers pointing at a desk camera.
-constexpr double kOutOfPlaneAxisMinZ = 0.5;
+constexpr double kOutOfPlaneAxisMinZ = 0.7;
 // Closed hand: [abd, flex1, flex2, flex3] for the thumb, then for each finger.
 constexpr std::array<double, 4> kClosedThumb = {0.3, 0.6, 0.5, 0.5};
 constexpr std::array<double, 4> kClosedFinger = {0.0, 1.3, 1.5, 0.9};
