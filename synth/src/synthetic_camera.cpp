@@ -167,7 +167,9 @@ const CameraIntrinsics& SyntheticCamera::camera() const { return state_->options
 const SubjectScale& SyntheticCamera::subject() const { return state_->shape.subject; }
 const HandShape& SyntheticCamera::shape() const { return state_->shape; }
 
-HandPose SyntheticCamera::pose(int frame) const { return state_->motion.pose(frame); }
+HandPose SyntheticCamera::pose(int frame) const {
+  return view_pose(state_->options.view, state_->motion.pose(frame), state_->shape);
+}
 
 SynthFrame SyntheticCamera::render(int frame) {
   SynthFrame out;
@@ -175,7 +177,7 @@ SynthFrame SyntheticCamera::render(int frame) {
   return out;
 }
 
-void SyntheticCamera::render(int frame, SynthFrame& out) { render_pose(state_->motion.pose(frame), frame, out); }
+void SyntheticCamera::render(int frame, SynthFrame& out) { render_pose(pose(frame), frame, out); }
 
 void SyntheticCamera::render_pose(const HandPose& pose, int frame, SynthFrame& out) {
   State& s = *state_;

@@ -474,3 +474,68 @@ TEST(SynthCamera, ALeftHandIsTheExactMirrorImageOfTheRightHand) {
         << "frame " << i;
   }
 }
+
+namespace {
+
+// The palm's normal from the ground-truth joints: wrist -> index MCP crossed with wrist -> little
+// MCP points out of the palm of a right hand.
+Eigen::Vector3d palm_normal(const Joints& j) {
+  const Eigen::Vector3d& wrist = j[handtrack::kWristJoint];
+  const Eigen::Vector3d index = j[handtrack::joint_index(1, 0)] - wrist;
+  const Eigen::Vector3d little = j[handtrack::joint_index(4, 0)] - wrist;
+  return index.cross(little).normalized();
+}
+
+// Every view shows the hand in the working volume, turned as its name says: the palm toward the
+// camera (normal z < 0) in palm, away in back and head-mounted, edge-on in side; fingers nearer
+// than the wrist with fingers-toward and farther with fingers-away and head-mounted; and a
+// head-mounted forearm comes up from the image bottom (its lower third) nearer than the
+// wrist.
+TEST(SynthViews, EachViewTurnsThePoseAsItsNameSays) {
+  const auto render = [](View view, int frame) {
+    SynthOptions o = clean_options("adbadd");
+    o.view = view;
+    return SyntheticCamera(o).render(frame);
+  };
+  for (const int i : {0, 100, 250}) {
+    SCOPED_TRACE("frame " + std::to_string(i));
+    const SynthFrame palm = render(View::kPalm, i);
+    EXPECT_LT(palm_normal(palm.joints).z(), -0.7);
+    EXPECT_GT(palm_normal(render(View::kBack, i).joints).z(), 0.7);
+    EXPECT_LT(std::abs(palm_normal(render(View::kSide, i).joints).z()), 0.5);
+    const auto finger_dz = [](const SynthFrame& f) {
+      return f.joints[handtrack::fingertip_joint(2)].z() - f.joints[handtrack::kWristJoint].z();
+    };
+    EXPECT_LT(finger_dz(render(View::kFingersToward, i)), finger_dz(palm) - 60.0);
+    EXPECT_GT(finger_dz(render(View::kFingersAway, i)), finger_dz(palm) + 60.0);
+    const SynthFrame head = render(View::kHeadMounted, i);
+    EXPECT_GT(palm_normal(head.joints).z(), 0.2);
+    EXPECT_GT(finger_dz(head), 80.0);
+    const auto& cam = head.depth.camera;
+    int near_bottom = 0;
+    for (int v = cam.height - cam.height / 3; v < cam.height; ++v) {
+      for (int u = 0; u < cam.width; ++u) {
+        const float z = head.depth.depth_mm[static_cast<size_t>(v) * cam.width + u];
+        near_bottom += z > 0.0F && z < head.joints[handtrack::kWristJoint].z() ? 1 : 0;
+      }
+    }
+    // (From the motion's start: adbadd later rolls the hand far about the viewing axis, which a
+    // view keeps, and the forearm with it.)
+    if (i == 0) {
+      EXPECT_GT(near_bottom, 200) << "the forearm comes from below, nearer than the wrist";
+    }
+    for (View v : kViews) {
+      const SynthFrame f = render(v, i);
+      int hand_pixels = 0;
+      for (size_t k = 0; k < f.labels.pixels.size(); ++k) {
+        hand_pixels += f.labels.pixels[k] != 0 && f.depth.depth_mm[k] >= 150.0F && f.depth.depth_mm[k] <= 600.0F;
+      }
+      EXPECT_GT(hand_pixels, 300) << view_name(v) << ": a hand in the working volume";
+    }
+  }
+  EXPECT_EQ(render(View::kPalm, 40).depth.depth_mm, SyntheticCamera(clean_options("adbadd")).render(40).depth.depth_mm);
+  for (View v : kViews) EXPECT_EQ(parse_view(view_name(v)), v);
+  EXPECT_FALSE(parse_view("top"));
+}
+
+}  // namespace

@@ -80,6 +80,7 @@ void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticC
                       {"noise_sigma_k_per_mm", o.noise_params.sigma_k_per_mm},
                       {"background", std::string(handtrack::synth::background_name(o.background))},
                       {"hand", std::string(handtrack::synth::handedness_name(o.hand))},
+                      {"view", std::string(handtrack::synth::view_name(o.view))},
                       {"fingers", bones},
                       {"pose_parameters", "poses.csv: frame, t_x,t_y,t_z (mm, wrist), r_x,r_y,r_z (axis-angle, "
                                           "R = exp(r) diag(1,-1,-1)), thumb..little abd,flex1,flex2,flex3 (rad)"}};
@@ -88,11 +89,16 @@ void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticC
   out << j.dump(1) << "\n";
 }
 
-// SPEC.md "Sequence directory": hand.json, which hand the sequence shows.
-void write_hand_json(const fs::path& file, handtrack::synth::Handedness hand) {
+// SPEC.md "Sequence directory": hand.json, which hand the sequence shows; ours besides: the view
+// and the motion, by which handtrack-eval groups its scores.
+void write_hand_json(const fs::path& file, const SynthOptions& o) {
   std::ofstream out(file);
   if (!out) throw std::runtime_error(file.string() + ": cannot write");
-  out << nlohmann::json{{"hands", {std::string(handtrack::synth::handedness_name(hand))}}}.dump() << "\n";
+  out << nlohmann::json{{"hands", {std::string(handtrack::synth::handedness_name(o.hand))}},
+                        {"view", std::string(handtrack::synth::view_name(o.view))},
+                        {"motion", o.motion}}
+             .dump()
+      << "\n";
 }
 
 class PosesCsv {
@@ -132,8 +138,10 @@ int main(int argc, char** argv) {
   std::string motion;
   std::string out_dir;
   std::string subject;
-  std::string background = "body";
+  std::string background;
   std::string hand = "right";
+  std::string view = "palm";
+  bool list_views = false;
   int frames = 300;
   int width = 320;
   int height = 240;
@@ -142,6 +150,7 @@ int main(int argc, char** argv) {
   bool preview = false;
   bool no_labels = false;
   app.add_flag("--list-motions", list, "List the motions and exit");
+  app.add_flag("--list-views", list_views, "List the views (camera arrangements) and exit");
   app.add_option("--motion", motion, "Motion: adbadd, fingercount, fingerwave, flexex1, pinch, random, tigergrasp");
   app.add_option("--frames", frames, "Number of frames (slow first half, fast second half)")
       ->check(CLI::Range(1, 1000000));
@@ -150,8 +159,11 @@ int main(int argc, char** argv) {
   app.add_option("--subject-scale", subject, "Subject scales L,W (length, width; 1 = mean adult; default: drawn "
                                              "from the seed within +-10%)");
   app.add_flag("--noise,!--no-noise", options.noise, "Sensor noise model on (default) or off");
-  app.add_option("--background", background, "Background: body (default), table or none");
+  app.add_option("--background", background,
+                 "Background: body (default; head-mounted view: table), table or none");
   app.add_option("--hand", hand, "right (default) or left: the right hand's exact mirror image");
+  app.add_option("--view", view, "Camera arrangement (see --list-views): palm (default), back, side, "
+                                 "fingers-toward, fingers-away, head-mounted");
   app.add_option("--width", width, "Image width (intrinsics scale with it)")->check(CLI::Range(16, 4096));
   app.add_option("--height", height, "Image height (intrinsics scale with it)")->check(CLI::Range(16, 4096));
   app.add_flag("--preview", preview, "Also write preview/NNNNNN.png (depth gray | labels in colour)");
@@ -166,11 +178,20 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
+  if (list_views) {
+    for (auto v : handtrack::synth::kViews) {
+      std::cout << handtrack::synth::view_name(v) << "\t" << handtrack::synth::view_description(v) << "\n";
+    }
+    return 0;
+  }
   if (motion.empty()) return fail("--motion is required (see --list-motions)");
   if (out_dir.empty()) return fail("--out is required");
   if (handtrack::synth::motion_description(motion).empty()) {
     return fail("unknown motion '" + motion + "' (see --list-motions)");
   }
+  const auto arrangement = handtrack::synth::parse_view(view);
+  if (!arrangement) return fail("unknown view '" + view + "' (see --list-views)");
+  if (background.empty()) background = *arrangement == handtrack::synth::View::kHeadMounted ? "table" : "body";
   const auto bg = handtrack::synth::parse_background(background);
   if (!bg) return fail("--background must be body, table or none, got '" + background + "'");
   const auto handedness = handtrack::synth::parse_handedness(hand);
@@ -181,6 +202,7 @@ int main(int argc, char** argv) {
     options.frames = frames;
     options.background = *bg;
     options.hand = *handedness;
+    options.view = *arrangement;
     options.camera = handtrack::synth::default_camera(width, height);
     if (!subject.empty()) options.subject = parse_subject(subject);
     handtrack::synth::SyntheticCamera cam(options);
@@ -189,7 +211,7 @@ int main(int argc, char** argv) {
     prepare_output(dir, force);
     handtrack::SequenceWriter writer(dir, cam.camera());
     write_subject_json(dir / "subject.json", cam);
-    write_hand_json(dir / "hand.json", *handedness);
+    write_hand_json(dir / "hand.json", options);
     PosesCsv poses(dir / "poses.csv");
     if (preview) fs::create_directories(dir / "preview");
 

@@ -16,6 +16,7 @@
 #include "handtrack/synth/hand_model.hpp"
 #include "handtrack/synth/motions.hpp"
 #include "handtrack/synth/noise.hpp"
+#include "handtrack/synth/views.hpp"
 
 #include <cstdint>
 #include <memory>
@@ -56,6 +57,7 @@ struct SynthOptions {
   CameraIntrinsics camera = default_camera();
   NoiseParams noise_params;
   Handedness hand = Handedness::kRight;
+  View view = View::kPalm;  // the camera arrangement (views.hpp): the motion turned and placed
 };
 
 // The virtual camera as handtrackd's `synthetic[:MOTION]` source shows it: `frames` per pass of
@@ -92,7 +94,8 @@ class SyntheticCamera {
   // frame, out.pose = pose.
   void render_pose(const HandPose& pose, int frame, SynthFrame& out);
 
-  // Pose and joints only (no image): cheap.
+  // The pose of frame i (the motion's, seen in options.view; the right-hand model's for a left
+  // hand too): no image, cheap.
   [[nodiscard]] HandPose pose(int frame) const;
 
   [[nodiscard]] const SynthOptions& options() const;
