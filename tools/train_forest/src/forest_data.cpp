@@ -80,6 +80,9 @@ Scene make_scene(uint64_t seed, uint64_t index, const SceneOptions& options) {
     s.from_motion = true;
     s.options.motion = std::string(synth::kMotionNames[rng.next() % synth::kMotionNames.size()]);
     s.frame = static_cast<int>(rng.next() % kTrainingSequenceFrames);
+    if (rng.uniform() < options.view_fraction) {
+      s.options.view = synth::kViews[1 + rng.next() % (synth::kViews.size() - 1)];  // [0] is palm
+    }
   } else {
     s.pose = random_pose(rng, synth::HandShape::for_subject(*s.options.subject), options);
   }
@@ -244,7 +247,8 @@ Confusion score_frame(const PartForest& forest, const DepthInput& input, const s
   return c;
 }
 
-HeldOutResult evaluate_motions(const PartForest& forest, uint64_t seed_base, int frames_per_motion) {
+HeldOutResult evaluate_motions(const PartForest& forest, uint64_t seed_base, int frames_per_motion,
+                               synth::View view) {
   HeldOutResult result;
   DepthInputBuilder builder;
   synth::SynthFrame frame;
@@ -255,6 +259,7 @@ HeldOutResult evaluate_motions(const PartForest& forest, uint64_t seed_base, int
     o.frames = kHeldOutSequenceFrames;
     o.seed = seed_base + m;
     o.background = kBackgrounds[m % kBackgrounds.size()];
+    o.view = view;
     synth::SyntheticCamera cam(o);
     for (int k = 0; k < frames_per_motion; ++k) {
       const int i = static_cast<int>((static_cast<int64_t>(k) * kHeldOutSequenceFrames + kHeldOutSequenceFrames / 2) /

@@ -55,6 +55,7 @@ std::string percent(double x) {
 
 struct EvalSummary {
   forest::HeldOutResult motions;
+  std::array<forest::Confusion, synth::kViews.size()> views;  // the held-out motions in each view
   forest::Confusion facing;  // held-out random poses, palm toward the camera (+- the SceneOptions ranges)
   forest::Confusion turned;  // held-out random poses turned any way (back, side, fingers toward / away)
   double ms_per_frame = 0.0;
@@ -64,10 +65,16 @@ struct EvalSummary {
 EvalSummary evaluate(const PartForest& model, int frames_per_motion, int scenes) {
   EvalSummary s;
   s.motions = forest::evaluate_motions(model, kHeldOutMotionSeed, frames_per_motion);
+  s.views[0] = s.motions.overall;
+  for (size_t v = 1; v < synth::kViews.size(); ++v) {
+    s.views[v] = forest::evaluate_motions(model, kHeldOutMotionSeed, frames_per_motion, synth::kViews[v]).overall;
+  }
   forest::SceneOptions facing;
   facing.turned_fraction = 0.0;
+  facing.view_fraction = 0.0;
   forest::SceneOptions turned;
   turned.turned_fraction = 1.0;
+  turned.view_fraction = 1.0;
   s.facing = forest::evaluate_scenes(model, kHeldOutSceneSeed, scenes, facing);
   s.turned = forest::evaluate_scenes(model, kHeldOutSceneSeed, scenes, turned);
   // Labelling time alone, on the held-out motion frames' inputs.
@@ -102,6 +109,11 @@ void print_evaluation(std::ostream& out, const PartForest& model, const EvalSumm
       << percent(s.motions.overall.part_accuracy()) << ")\n";
   for (size_t m = 0; m < synth::kMotionNames.size(); ++m) {
     out << "  " << synth::kMotionNames[m] << ": " << percent(s.motions.per_motion[m].accuracy()) << "\n";
+  }
+  out << "held-out motions per view:\n";
+  for (size_t v = 0; v < synth::kViews.size(); ++v) {
+    out << "  " << synth::view_name(synth::kViews[v]) << ": " << percent(s.views[v].accuracy()) << " (hand parts only "
+        << percent(s.views[v].part_accuracy()) << ")\n";
   }
   for (const auto& [name, c] : {std::pair{"palm toward the camera", &s.facing}, std::pair{"turned any way", &s.turned}}) {
     out << "held-out random poses, " << name << " (" << c->total() << " hand pixels): accuracy "
@@ -205,6 +217,10 @@ int main(int argc, char** argv) {
   app.add_option("--turned-fraction", scene.turned_fraction,
                  "Share of the random poses turned any way (back, side, fingers toward or away)")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--view-fraction", scene.view_fraction,
+                 "Share of the motion images seen in another view than palm (back, side, fingers toward or away, "
+                 "head-mounted)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--motion-fraction", scene.motion_fraction, "Share of images from the motion scripts")
       ->check(CLI::Range(0.0, 1.0));
   app.add_option("--seed", train.seed, "Seed of the data set and of the training");
@@ -260,7 +276,8 @@ int main(int argc, char** argv) {
             << train.max_depth << " --images " << images << " --pixels-per-image " << train.pixels_per_image
             << " --candidates " << train.candidates << " --thresholds " << train.thresholds_per_feature
             << " --min-leaf " << train.min_leaf_samples << " --motion-fraction " << scene.motion_fraction
-            << " --turned-fraction " << scene.turned_fraction << " --seed " << train.seed;
+            << " --turned-fraction " << scene.turned_fraction << " --view-fraction " << scene.view_fraction
+            << " --seed " << train.seed;
     const auto t1 = std::chrono::steady_clock::now();
     progress.restart();
     PartForest model = forest::train_forest(data, scene.camera, train, command.str(), [&](const forest::TrainProgress& p) {

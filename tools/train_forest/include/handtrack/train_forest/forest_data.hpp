@@ -45,6 +45,9 @@ struct SceneOptions {
   // a side toward the camera (yaw up to 180 deg), fingers toward or away from it (pitch up to
   // kMaxTurnedPitchDeg), any roll.
   double turned_fraction = 0.5;
+  // Share of the motion frames seen in another view than palm (synth/views.hpp: back, side, fingers
+  // toward or away, head-mounted), drawn uniformly among them.
+  double view_fraction = 0.5;
   CameraIntrinsics camera = synth::default_camera();
 };
 
@@ -96,13 +99,14 @@ Confusion score_frame(const PartForest& forest, const DepthInput& input, const s
 
 // Held-out synthetic frames: each of the seven motion scripts with its own random subject
 // (seed = seed_base + motion index, backgrounds cycling body/table/none), `frames_per_motion`
-// frames spread over a 241-frame sequence (training uses 300-frame sequences).
+// frames spread over a 241-frame sequence (training uses 300-frame sequences), seen in `view`.
 struct HeldOutResult {
   std::array<Confusion, 7> per_motion;
   Confusion overall;
   int frames = 0;
 };
-HeldOutResult evaluate_motions(const PartForest& forest, uint64_t seed_base, int frames_per_motion);
+HeldOutResult evaluate_motions(const PartForest& forest, uint64_t seed_base, int frames_per_motion,
+                               synth::View view = synth::View::kPalm);
 // Held-out random poses: the scenes of data set `seed` (use one never trained on), `count` frames.
 Confusion evaluate_scenes(const PartForest& forest, uint64_t seed, int count, const SceneOptions& options);
 
