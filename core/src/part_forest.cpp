@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -460,6 +461,15 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
     }
   }
   if (pending > 0) flush();
+}
+
+std::optional<std::filesystem::path> shipped_forest_path() {
+  if (const char* env = std::getenv("HANDTRACK_FOREST"); env != nullptr && *env != '\0') return env;
+  for (const char* candidate : {HANDTRACK_SOURCE_FOREST, HANDTRACK_INSTALLED_FOREST}) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(candidate, ec)) return candidate;
+  }
+  return std::nullopt;
 }
 
 }  // namespace handtrack

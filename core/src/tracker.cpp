@@ -50,6 +50,16 @@ const char* to_string(EnergyMode mode) {
   return mode == EnergyMode::kLateFusion ? "late-fusion" : "depth-only";
 }
 
+bool parse_energy_mode(const std::string& text, EnergyMode* mode) {
+  for (EnergyMode m : {EnergyMode::kLateFusion, EnergyMode::kDepthOnly}) {
+    if (text == to_string(m)) {
+      *mode = m;
+      return true;
+    }
+  }
+  return false;
+}
+
 const char* to_string(TrackingState state) {
   switch (state) {
     case TrackingState::kNoHand: return "no_hand";

@@ -270,18 +270,29 @@ Pipeline::~Pipeline() {
 bool Pipeline::start(std::string* why) {
   Impl& m = *impl_;
   if (!m.config.record_dir.empty()) m.recorder = std::make_unique<Recorder>(m.config.record_dir, m.tally);
+  std::optional<std::filesystem::path> forest_path;
+  if (m.config.tracker.mode == EnergyMode::kLateFusion) {
+    // A forest named in the configuration must load; without one, the shipped forest, and where
+    // even that is missing (a partial install), depth-only with a warning rather than no tracking.
+    forest_path = m.config.forest_model.empty() ? shipped_forest_path()
+                                                : std::optional<std::filesystem::path>(m.config.forest_model);
+    if (forest_path) {
+      try {
+        m.forest.emplace(PartForest::load(*forest_path));
+      } catch (const std::exception& e) {
+        *why = e.what();
+        return false;
+      }
+    } else {
+      m.config.tracker.mode = EnergyMode::kDepthOnly;
+      log().warn("no part forest found (tracker.forest_model is empty, $HANDTRACK_FOREST unset, none shipped): "
+                 "depth-only");
+    }
+  }
+  // The source starts after the forest is loaded: a recording plays in real time from its start.
   m.grab.emplace(m.config, *m.source, m.ring, m.tally, m.watch, m.grab_bell, m.recorder.get());
   if (!m.grab->start(why)) return false;
-  if (!m.config.forest_model.empty()) {
-    try {
-      m.forest.emplace(PartForest::load(m.config.forest_model));
-    } catch (const std::exception& e) {
-      *why = e.what();
-      return false;
-    }
-    m.config.tracker.mode = EnergyMode::kLateFusion;
-    log().info("part forest {}: late fusion", m.config.forest_model);
-  }
+  if (m.forest) log().info("part forest {}: late fusion", forest_path->string());
   m.reload.emplace(m.config.tracker);
   const PartForest* forest = m.forest ? &*m.forest : nullptr;
   m.preprocess.emplace(m.config.tracker, *m.reload, m.request, forest, m.tally, m.watch);

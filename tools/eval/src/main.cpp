@@ -99,7 +99,7 @@ int main(int argc, char** argv) {
   std::string csv_file;
   std::string tips_file;
   std::string hand = "auto";
-  std::string energy = "depth-only";
+  std::string energy = "late-fusion";
   TrackerConfig config;
   app.add_option("sequences", dirs, "sequence directories (SPEC.md format, with groundtruth.csv)")
       ->required()
@@ -112,9 +112,12 @@ int main(int argc, char** argv) {
                  "coordinates (mm; empty where not annotated); what scripts/filter-table smooths");
   app.add_option("--hand", hand, "auto (default: both hands, the better fit chosen at every (re)start), right or left")
       ->check(CLI::IsMember({"right", "left", "auto"}));
-  app.add_option("--energy", energy, "depth-only or late-fusion")->check(CLI::IsMember({"depth-only", "late-fusion"}));
+  app.add_option("--energy", energy, "late-fusion (default, with the shipped forest) or depth-only")
+      ->check(CLI::IsMember({"depth-only", "late-fusion"}));
   std::string forest_file;
-  app.add_option("--forest", forest_file, "part-classification forest for late fusion (data/part_forest.htf)")
+  app.add_option("--forest", forest_file,
+                 "part-classification forest for late fusion (default: the shipped one, $HANDTRACK_FOREST, "
+                 "data/ or /usr/share/handtrack)")
       ->check(CLI::ExistingFile);
   app.add_option("--particles", config.particles, "pose particles per frame")->check(CLI::Range(1, 64));
   app.add_option("--iterations", config.optimizer.iterations, "optimizer iterations per particle")
@@ -135,8 +138,14 @@ int main(int argc, char** argv) {
   app.add_flag("--sim-only", sim_only, "E_sim only: drop E_col, E_lim and E_smo (ablation of Fig. 6)");
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
   if (energy == "late-fusion" && forest_file.empty() && !oracle_labels) {
-    return report_error(kProgram,
-                               "--energy late-fusion needs --forest MODEL (handtrack-train-forest) or --oracle-labels", 1);
+    const auto shipped = shipped_forest_path();
+    if (!shipped) {
+      return report_error(kProgram,
+                          "no part forest found for late fusion: pass --forest MODEL, set $HANDTRACK_FOREST, or use "
+                          "--energy depth-only",
+                          1);
+    }
+    forest_file = shipped->string();
   }
   if (energy == "late-fusion") config.mode = EnergyMode::kLateFusion;
   parse_handedness_mode(hand, &config.handedness);  // one of the names CLI11 checked

@@ -45,6 +45,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -161,5 +162,10 @@ class PartForest final : public PixelLabeller {
   PartForestInfo info_;
   PartForestOptions options_;
 };
+
+// The shipped forest (data/part_forest.htf), for programs that use it without being told where
+// it is: $HANDTRACK_FOREST if set, else the source tree this library was built from, else the
+// installed data directory (<prefix>/share/handtrack). nullopt when none of them has the file.
+std::optional<std::filesystem::path> shipped_forest_path();
 
 }  // namespace handtrack

@@ -47,9 +47,12 @@ enum class EnergyMode {
 //   are compared by one common energy, E with E_sim = (1 - lambda) E_sim[Delta] + lambda E_sim[Delta_l],
 //   lambda = TrackerConfig::fusion_label_weight. With lambda = 0 (the depth-only energy) the right
 //   pose of a closed hand loses to the wrong one the depth-only energy prefers (docs/TRACKER.md).
-const char* to_string(EnergyMode mode);
+const char* to_string(EnergyMode mode);  // "late-fusion", "depth-only"
+bool parse_energy_mode(const std::string& text, EnergyMode* mode);
 
 struct TrackerConfig {
+  // PoseTracker's default: depth-only (it has no labels unless given a labeller); handtrackd and
+  // handtrack-eval default to late fusion with the shipped forest.
   EnergyMode mode = EnergyMode::kDepthOnly;
   HandednessMode handedness = HandednessMode::kAuto;  // Tracker only (a PoseTracker is one hand)
   DepthInputConfig input;

@@ -45,6 +45,13 @@ struct PipelineConfig {
   int stats_interval_ms = 1000;  // statistics into the ring header, STATUS= and the debug summary
 };
 
+// The tracker's defaults, with late fusion (the shipped forest): the daemon's best configuration.
+inline TrackerConfig late_fusion_defaults() {
+  TrackerConfig c;
+  c.mode = EnergyMode::kLateFusion;
+  return c;
+}
+
 struct DaemonConfig {
   // [daemon]
   std::string source = "openni2";       // SPEC.md "Sources"
@@ -61,9 +68,9 @@ struct DaemonConfig {
   // [pipeline]
   PipelineConfig pipeline;
   // [tracker], [tracker.input], [tracker.energy], [tracker.optimizer], [tracker.scale]
-  TrackerConfig tracker;
-  // Part-classification forest (handtrack-train-forest); set: late fusion (Sec. 5), empty:
-  // every particle optimises the depth-only energy.
+  TrackerConfig tracker = late_fusion_defaults();
+  // Part-classification forest (handtrack-train-forest) for late fusion (tracker.energy, Sec. 5);
+  // empty: the shipped one (shipped_forest_path()).
   std::string forest_model;
   // Hand profile (handtrack-calibrate, Sec. 6): loaded with the configuration, its scales replace
   // tracker.scale; empty: tracker.scale as configured.
