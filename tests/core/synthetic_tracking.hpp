@@ -14,11 +14,6 @@ namespace handtrack::testing {
 
 inline constexpr int kSequenceFrames = 300;
 
-inline const std::filesystem::path& shipped_forest_path() {
-  static const std::filesystem::path path = std::filesystem::path(HANDTRACK_SOURCE_DIR) / "data" / "part_forest.htf";
-  return path;
-}
-
 inline TrackerConfig paper_config(EnergyMode mode) {
   TrackerConfig config;
   config.mode = mode;

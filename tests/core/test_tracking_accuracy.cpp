@@ -40,7 +40,7 @@ void expect_sane(const eval::SequenceScore& s, const char* energy) {
 }
 
 TEST(TrackingAccuracy, SevenSyntheticMotionsDepthOnlyAndLateFusion2Particles10Iterations) {
-  const PartForest forest = PartForest::load(testing::shipped_forest_path());
+  const PartForest forest = PartForest::load(shipped_forest_path().value());
   std::vector<eval::SequenceScore> depth_only;
   std::vector<eval::SequenceScore> late_fusion;
   for (const auto motion : synth::kMotionNames) {

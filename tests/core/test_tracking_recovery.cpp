@@ -61,7 +61,7 @@ std::vector<int> frames_to_recover(const std::vector<double>& knocked_mm, const 
 // kKnockFrames. Measured: all 21 knocks repaired, 20 within 2 frames, random's at frame 140 in 13
 // (docs/TRACKER.md, "Recovery"); before the confidence check, 14 of 21.
 TEST(TrackingRecovery, BackWithin30FramesAfterAGrossError) {
-  const PartForest forest = PartForest::load(testing::shipped_forest_path());
+  const PartForest forest = PartForest::load(shipped_forest_path().value());
   std::mt19937_64 rng(4);
   for (const auto motion : synth::kMotionNames) {
     auto camera = testing::motion_camera(motion);
@@ -112,7 +112,7 @@ TEST(TrackingRecovery, HandLeavingTheWorkingVolumeIsNoHandAndIsFoundAgain) {
   constexpr double kStepMm = 15.0;      // away per frame, then back
   constexpr int kAwayFrames = 40;       // 600 mm further: the whole hand (and forearm) beyond 600 mm
   constexpr int kTotalFrames = kApproachFrames + 2 * kAwayFrames + kRecoveryFrames;
-  const PartForest forest = PartForest::load(testing::shipped_forest_path());
+  const PartForest forest = PartForest::load(shipped_forest_path().value());
   Tracker tracker(testing::paper_config(EnergyMode::kLateFusion));
   auto camera = testing::motion_camera("fingerwave");
   const double far_mm = tracker.pose_tracker().config().input.far_mm;

@@ -27,7 +27,7 @@ namespace {
 
 using namespace handtrack;
 
-std::string g_forest_path = HANDTRACK_DEFAULT_FOREST;
+std::string g_forest_path = handtrack::shipped_forest_path().value_or("");
 constexpr double kLabelRadiusMm = 200.0;  // EnergyWeights' R_i
 
 const std::vector<testing::EnergyCase>& cases() {

@@ -46,7 +46,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 int main(int argc, char** argv) {
   CLI::App app{"The paper's speed table: every configuration on the same synthetic 320x240 frames, one thread."};
   std::string json_file;
-  std::string forest_file = HANDTRACK_DEFAULT_FOREST;
+  std::string forest_file = shipped_forest_path().value_or("");
   std::string motion = "random";
   int frames = 300;
   app.add_option("--json", json_file, "write the table as JSON (SPEC.md)");
@@ -77,16 +77,17 @@ int main(int argc, char** argv) {
       tc.mode = bc.mode;
       tc.particles = bc.particles;
       tc.optimizer.iterations = bc.iterations;
-      DepthInputBuilder builder(tc.input);
-      PoseTracker tracker(tc);
+      // The shipped tracker (both hands considered, handedness auto), its two steps timed apart.
+      TrackerInputs inputs(tc.input);
+      Tracker tracker(tc);
       const PixelLabeller* labeller = bc.mode == EnergyMode::kLateFusion ? &forest : nullptr;
       std::vector<double> pre_ms, opt_ms, latency_ms;
       const auto start = std::chrono::steady_clock::now();
       for (int i = 0; i < frames; ++i) {
         const auto t0 = std::chrono::steady_clock::now();
-        const DepthInput& in = builder.build(input[static_cast<size_t>(i)], tracker.hint(), labeller);
+        inputs.build(input[static_cast<size_t>(i)], tracker.request(), labeller);
         const auto t1 = std::chrono::steady_clock::now();
-        (void)tracker.optimise(in);
+        (void)tracker.optimise(inputs);
         pre_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
         opt_ms.push_back(ms_since(t1));
         latency_ms.push_back(pre_ms.back() + opt_ms.back());
