@@ -52,6 +52,14 @@ struct Args {
   int panel_height = 0;
 };
 
+// What the tracker segmented for the hand it reports, in the frame's own image (a left hand's
+// input is of the mirrored frame).
+handtrack::DepthInput tracker_input(const handtrack::Tracker& tracker, const handtrack::TrackerOutput& output) {
+  const handtrack::DepthInput* input = tracker.last_input();
+  if (input == nullptr) throw std::runtime_error("the tracker preprocessed no input for the hand it reports");
+  return output.handedness == handtrack::Handedness::kLeft ? handtrack::view::unmirrored(*input) : *input;
+}
+
 handtrack::TrackerConfig tracker_config(const Args& a) {
   handtrack::TrackerConfig config;
   if (a.iterations) config.optimizer.iterations = *a.iterations;
@@ -123,7 +131,9 @@ int run_sequence(const Args& a) {
     const bool annotated = std::any_of(tips.begin(), tips.end(), [](const auto& t) { return t.has_value(); });
     handtrack::view::FrameView view;
     view.depth = &depth;
-    view.input = tracker.last_input();
+    const auto input = tracker_input(tracker, output);
+    view.input = &input;
+    view.mirrored_model = output.handedness == handtrack::Handedness::kLeft;
     view.output = &output;
     view.model = &tracker.pose_tracker().model();
     view.labels = labels ? &*labels : nullptr;
@@ -187,7 +197,9 @@ int run_single(const Args& a) {
   const handtrack::TrackerOutput output = tracker.track(depth);
   handtrack::view::FrameView view;
   view.depth = &depth;
-  view.input = tracker.last_input();
+  const auto input = tracker_input(tracker, output);
+  view.input = &input;
+  view.mirrored_model = output.handedness == handtrack::Handedness::kLeft;
   view.output = &output;
   view.model = &tracker.pose_tracker().model();
   view.labels = labels ? &*labels : nullptr;

@@ -206,7 +206,8 @@ Panel model_panel(const FrameView& f, const ViewMap& view, std::pair<double, dou
     std::sort(order.begin(), order.end(), [&hand](int a, int b) { return hand.centre(a).z() > hand.centre(b).z(); });
     const auto& model_gaussians = f.model->gaussians();
     for (int i : order) {
-      const Eigen::Vector3d& p = hand.centre(i);
+      Eigen::Vector3d p = hand.centre(i);
+      if (f.mirrored_model) p.x() = -p.x();
       if (!(p.z() > 1.0)) continue;
       const auto& mg = model_gaussians[static_cast<size_t>(i)];
       const auto uv = cam.project(p);
@@ -250,7 +251,10 @@ Panel model_panel(const FrameView& f, const ViewMap& view, std::pair<double, dou
   }
   Panel p{std::move(c), {}};
   p.caption = std::string("model: ") + to_string(out.state);
-  if (posed) p.caption += format("  conf %.2f", out.confidence) + format("  E %.3g", out.energy);
+  if (posed) {
+    p.caption += std::string(", ") + to_string(out.handedness) + " hand" + format("  conf %.2f", out.confidence) +
+                 format("  E %.3g", out.energy);
+  }
   if (f.truth_tips != nullptr) {
     if (const auto err = fingertip_error_mm(out, *f.truth_tips); err && posed) {
       p.caption += format("\ntip error %.1f mm (x = truth)", *err);
@@ -293,6 +297,24 @@ std::optional<double> fingertip_error_mm(const TrackerOutput& output, const Fing
   }
   if (n == 0) return std::nullopt;
   return sum / n;
+}
+
+DepthInput unmirrored(const DepthInput& input) {
+  DepthInput out = input;
+  const int w = input.camera.width;
+  out.camera.cx = static_cast<double>(w - 1) - input.camera.cx;
+  const auto flip_rows = [w](auto& pixels) {
+    for (size_t row = 0; row + static_cast<size_t>(w) <= pixels.size(); row += static_cast<size_t>(w)) {
+      std::reverse(pixels.begin() + static_cast<std::ptrdiff_t>(row),
+                   pixels.begin() + static_cast<std::ptrdiff_t>(row) + w);
+    }
+  };
+  flip_rows(out.filtered_mm);
+  flip_rows(out.hand_mask);
+  flip_rows(out.pixel_labels);
+  for (auto& g : out.gaussians) g.u = static_cast<double>(w - 1) - g.u;
+  for (Eigen::Vector3d* p : {&out.hand_centroid_mm, &out.palm_centre_mm, &out.finger_axis}) p->x() = -p->x();
+  return out;
 }
 
 RgbImage render_frame(const FrameView& f, const RenderOptions& options) {
