@@ -44,6 +44,18 @@ constexpr double kExplainMarginMm = 10.0;
 // camera merely occludes it.
 constexpr double kFloatSigmas = 3.0;
 constexpr double kFloatMarginMm = 20.0;
+
+// The value among `values` whose to_string() is `text`.
+template <typename Enum>
+bool parse_name(const std::string& text, std::initializer_list<Enum> values, Enum* out) {
+  for (Enum v : values) {
+    if (text == to_string(v)) {
+      *out = v;
+      return true;
+    }
+  }
+  return false;
+}
 }  // namespace
 
 const char* to_string(EnergyMode mode) {
@@ -51,13 +63,7 @@ const char* to_string(EnergyMode mode) {
 }
 
 bool parse_energy_mode(const std::string& text, EnergyMode* mode) {
-  for (EnergyMode m : {EnergyMode::kLateFusion, EnergyMode::kDepthOnly}) {
-    if (text == to_string(m)) {
-      *mode = m;
-      return true;
-    }
-  }
-  return false;
+  return parse_name(text, {EnergyMode::kLateFusion, EnergyMode::kDepthOnly}, mode);
 }
 
 const char* to_string(TrackingState state) {
@@ -81,13 +87,7 @@ const char* to_string(HandednessMode mode) {
 }
 
 bool parse_handedness_mode(const std::string& text, HandednessMode* mode) {
-  for (HandednessMode m : {HandednessMode::kAuto, HandednessMode::kLeft, HandednessMode::kRight}) {
-    if (text == to_string(m)) {
-      *mode = m;
-      return true;
-    }
-  }
-  return false;
+  return parse_name(text, {HandednessMode::kAuto, HandednessMode::kLeft, HandednessMode::kRight}, mode);
 }
 
 namespace {
