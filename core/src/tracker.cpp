@@ -179,9 +179,12 @@ bool Tracker::prefer(const TrackerOutput& a, const TrackerOutput& b) const {
 
 bool Tracker::both() const {
   if (config().handedness != HandednessMode::kAuto) return false;
-  const bool unsettled_check = !settled_ && frames_since_hand_check_ >= config().handedness_check_frames;
-  // The current hand's tracker gives no hint while it tracks only before a suspect-fit check.
-  return !tracking_ || unsettled_check || !side(current_).hint();
+  // An unclear choice is re-examined every handedness_check_frames frames and at every suspect-fit
+  // check (the current hand's tracker gives no hint while it tracks only before one); a clear one
+  // is kept (a clear choice re-examined at suspect fits lost the fists of flexex1 to a left hand
+  // that explained more of the closing hand).
+  const bool due = frames_since_hand_check_ >= config().handedness_check_frames || !side(current_).hint();
+  return !tracking_ || (!settled_ && due);
 }
 
 TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {

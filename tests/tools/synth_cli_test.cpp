@@ -116,7 +116,7 @@ TEST_F(SynthCli, Writes640x480SequenceWithConsistentGroundTruth) {
   EXPECT_NEAR(reader.camera().fps, 60.0, 1e-9);
   ASSERT_TRUE(reader.has_groundtruth());
 
-  EXPECT_EQ(nlohmann::json::parse(slurp(seq / "hand.json")), nlohmann::json::parse(R"({"hands":["right"]})"));
+  EXPECT_EQ(nlohmann::json::parse(slurp(seq / "hand.json")), nlohmann::json::parse(R"({"hands":["right"],"view":"palm","motion":"fingerwave"})"));
   const auto subject = nlohmann::json::parse(slurp(seq / "subject.json"));
   EXPECT_DOUBLE_EQ(subject.at("length_scale").get<double>(), 1.08);
   EXPECT_DOUBLE_EQ(subject.at("width_scale").get<double>(), 0.94);

@@ -82,8 +82,8 @@ struct TrackerConfig {
   double min_start_confidence = 0.6;
   // Auto handedness (Tracker; ours): a hand chosen by less than this confidence margin is not
   // settled (a fist, a flat hand seen edge-on: both hands explain it), and the other hand is fitted
-  // again from its (re)start every `handedness_check_frames` frames until one wins by the margin.
-  // Every suspect-confidence check (above) also fits the other hand.
+  // again from its (re)start every `handedness_check_frames` frames, and at every suspect-confidence
+  // check (above), until one wins by the margin.
   double handedness_margin = 0.05;
   int handedness_check_frames = 30;
   uint64_t seed = 1;
@@ -219,9 +219,9 @@ class TrackerInputs {
 // right-hand model in the mirrored image. With HandednessMode::kAuto both hands are fitted at
 // every (re)start (no hand yet, lost, recovering) and the one that explains more of the hand
 // (confidence) is kept; while it tracks, only it runs, except on checks: the tracked hand then
-// competes with the other hand's (re)start, which replaces it when it explains more. A check
-// comes with every suspect fit (PoseTracker's gross-error check) and, while the last choice was
-// not clear (TrackerConfig::handedness_margin), every handedness_check_frames frames.
+// competes with the other hand's (re)start, which replaces it when it explains more. Checks come
+// only while the last choice was not clear (TrackerConfig::handedness_margin): every
+// handedness_check_frames frames and with every suspect fit (PoseTracker's gross-error check).
 //
 // Threading: request() and optimise() on one thread; TrackerInputs::build() anywhere, on inputs
 // the optimising thread does not read at the time.
