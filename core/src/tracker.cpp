@@ -16,9 +16,15 @@ namespace {
 // fist, a closed hand; each turned by a few in-plane rotations (rad) around the segmented axis.
 constexpr std::array<double, 3> kStartRotations = {0.0, 0.4, -0.4};
 constexpr std::array<bool, 2> kStartClosed = {false, true};
-// ... each with the palm toward the camera and with the back of the hand toward it (turned half a
-// turn about the hand's finger axis).
-constexpr std::array<bool, 2> kStartBack = {false, true};
+// ... each with the palm toward the camera, the back of the hand, and either edge (the thumb's,
+// the little finger's): turned about the hand's finger axis (rad). Without the edges a hand seen
+// side-on was fitted as a flattened hand of the other side (docs/TRACKER.md, "Every view").
+constexpr std::array<double, 4> kStartTurns = {0.0, std::numbers::pi, 0.5 * std::numbers::pi,
+                                               -0.5 * std::numbers::pi};
+// A check of a tracked pose (a suspect fit) tries the palm and the back only: with the edges too,
+// depth-only tracking of `random` and `tigergrasp` drifted off for good after checks that an edge
+// hypothesis won. A hand lost for good starts again from all turns.
+constexpr size_t kCheckTurns = 4;
 // A hand whose segmented axis points this much toward or away from the camera (|a_z|, the sine of
 // the angle out of the image plane: 45 deg) is also started with its fingers along that axis in 3D:
 // a hand reaching forward under a head-mounted camera, fingers pointing at a desk camera.
@@ -57,6 +63,10 @@ bool parse_name(const std::string& text, std::initializer_list<Enum> values, Enu
   return false;
 }
 }  // namespace
+
+double fit_score(double confidence, double label_agreement) {
+  return label_agreement < 0.0 ? confidence : confidence * label_agreement;
+}
 
 const char* to_string(EnergyMode mode) {
   return mode == EnergyMode::kLateFusion ? "late-fusion" : "depth-only";
@@ -173,8 +183,10 @@ bool Tracker::prefer(const TrackerOutput& a, const TrackerOutput& b) const {
   // wins, the common view of a desk camera facing the user (docs/TRACKER.md, "Left hands").
   const bool a_palm = a.palm_normal.z() < 0.0;
   const bool b_palm = b.palm_normal.z() < 0.0;
-  if (a_palm != b_palm && std::abs(a.confidence - b.confidence) < config().handedness_margin) return a_palm;
-  return a.confidence > b.confidence;
+  const double a_score = fit_score(a.confidence, a.label_agreement);
+  const double b_score = fit_score(b.confidence, b.label_agreement);
+  if (a_palm != b_palm && std::abs(a_score - b_score) < config().handedness_margin) return a_palm;
+  return a_score > b_score;
 }
 
 bool Tracker::both() const {
@@ -200,7 +212,9 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
     const bool left_wins = prefer(as_left, as_right);
     current_ = left_wins ? Handedness::kLeft : Handedness::kRight;
     side(left_wins ? Handedness::kRight : Handedness::kLeft).reset();
-    handedness_confidence_ = std::clamp(std::abs(as_left.confidence - as_right.confidence), 0.0, 1.0);
+    handedness_confidence_ = std::clamp(std::abs(fit_score(as_left.confidence, as_left.label_agreement) -
+                                                 fit_score(as_right.confidence, as_right.label_agreement)),
+                                        0.0, 1.0);
     settled_ = handedness_confidence_ >= config().handedness_margin;
     frames_since_hand_check_ = 0;
     out = left_wins ? as_left : as_right;
@@ -272,7 +286,7 @@ PoseParams PoseTracker::initial_pose(const DepthInput& input, const Start& start
   const double phi = std::atan2(axis.x(), -axis.y()) + start.in_plane_offset_rad;
   PoseParams params = PoseParams::Zero();
   Eigen::Matrix3d turn = Eigen::AngleAxisd(phi, Vector3d::UnitZ()).toRotationMatrix() *
-                         Eigen::AngleAxisd(start.back ? std::numbers::pi : 0.0, Vector3d::UnitY()).toRotationMatrix();
+                         Eigen::AngleAxisd(start.turn_rad, Vector3d::UnitY()).toRotationMatrix();
   if (start.along_axis_3d) {
     // Then tipped about the camera-frame axis perpendicular to both (the image-plane direction and
     // the 3D axis) until the fingers run along the 3D axis: the palm (or back) stays as square to
@@ -282,8 +296,7 @@ PoseParams PoseTracker::initial_pose(const DepthInput& input, const Start& start
     turn = Eigen::Quaterniond::FromTwoVectors(in_plane, along).toRotationMatrix() * turn;
   }
   params.segment<3>(kRotationParam) = rotation_log(turn);
-  const bool closed = start.closed;
-  if (closed) {
+  if (start.closed) {
     for (int f = 0; f < kNumFingers; ++f) {
       for (int d = 0; d < 4; ++d) {
         params[angle_param(f, d)] = (f == kThumb ? kClosedThumb : kClosedFinger)[static_cast<size_t>(d)];
@@ -291,18 +304,32 @@ PoseParams PoseTracker::initial_pose(const DepthInput& input, const Start& start
     }
   }
   const PosedHand at_origin(model_, params);
-  // The segmented palm centre is a surface point; the model's palm centre is half a palm inside.
-  // A closed hand shows its curled fingers, which lie in front of the palm by about two finger
-  // thicknesses.
-  const double palm_half_thickness = model_.gaussians().back().sigma_mm;
-  const double behind_surface = palm_half_thickness + (closed ? kClosedFingersInFrontMm : 0.0);
+  // The segmented palm centre is a surface point; the model's palm centre lies behind it: half a
+  // palm thickness behind the palm or the back, half the palm's width behind an edge. A closed hand
+  // shows its curled fingers, which lie in front of the palm by about two finger thicknesses.
+  // (Measured the other way, as the depth of the posed model's nearest surface along the ray
+  // through its palm centre, this put the fists of fingercount 75 mm off.)
+  const double palm_half_thickness = model_.gaussians().back().sigma_mm;  // the knuckle row's
+  double palm_half_width = 0.0;
+  for (const auto& g : model_.gaussians()) {
+    if (g.bone != kPalmBone) continue;
+    palm_half_width = std::max(palm_half_width, std::abs(g.palm_position.x()) + g.sigma_mm);
+  }
+  const double facing = std::abs(std::cos(start.turn_rad));
+  const double behind_surface = facing * (palm_half_thickness + (start.closed ? kClosedFingersInFrontMm : 0.0)) +
+                                (1.0 - facing) * palm_half_width;
   const Vector3d target = input.palm_centre_mm + Vector3d(0, 0, behind_surface);
-  params.segment<3>(kTranslationParam) = target - at_origin.camera_R_hand() * model_.palm_centre();
+  const Vector3d centre = at_origin.camera_R_hand() * model_.palm_centre();
+  params.segment<3>(kTranslationParam) = target - centre;
   return params;
 }
 
 double PoseTracker::confidence(const DepthInput& input, const PosedHand& hand) const {
-  if (input.gaussians.empty()) return 0.0;
+  return explain(input, hand).confidence;
+}
+
+PoseTracker::Explained PoseTracker::explain(const DepthInput& input, const PosedHand& hand) const {
+  if (input.gaussians.empty()) return {};
   const auto& cam = input.camera;
   const auto& gaussians = model_.gaussians();
   struct Projected {
@@ -334,24 +361,38 @@ double PoseTracker::confidence(const DepthInput& input, const PosedHand& hand) c
     const double surface = mu.z() - sigma_h;
     if (d <= 0.0F || d > surface + kFloatSigmas * sigma_h + kFloatMarginMm) ++bad;
   }
+  // Each leaf is explained by the covering model Gaussian nearest to it (relative to its reach in
+  // the image); a labelled leaf agrees when that Gaussian is of the same finger (or both palm).
   double covered = 0.0;
   double total = 0.0;
+  double labelled = 0.0;
+  double agreeing = 0.0;
   for (const auto& q : input.gaussians) {
     const double area = static_cast<double>(q.side_px) * q.side_px;
     total += area;
+    int nearest = -1;
+    double nearest_ratio = 1.0;
     for (int p = 0; p < m; ++p) {
       const auto& pr = projected[static_cast<size_t>(p)];
       const double du = pr.u - q.u;
       const double dv = pr.v - q.v;
       const double r = pr.sigma + 0.5 * q.side_px;
-      if (du * du + dv * dv < r * r && std::abs(pr.depth - q.depth_mm) < pr.reach) {
-        covered += area;
-        break;
+      const double ratio = (du * du + dv * dv) / (r * r);
+      if (ratio < nearest_ratio && std::abs(pr.depth - q.depth_mm) < pr.reach) {
+        nearest = p;
+        nearest_ratio = ratio;
+        if (q.label == kBackground) break;  // any covering Gaussian explains an unlabelled leaf
       }
+    }
+    if (nearest < 0) continue;
+    covered += area;
+    if (q.label != kBackground) {
+      labelled += area;
+      if (part_finger(q.label) == part_finger(gaussians[static_cast<size_t>(nearest)].label)) agreeing += area;
     }
   }
   const double coverage = total > 0.0 ? covered / total : 0.0;
-  return coverage * (1.0 - static_cast<double>(bad) / std::max(1, m));
+  return {coverage * (1.0 - static_cast<double>(bad) / std::max(1, m)), labelled > 0.0 ? agreeing / labelled : -1.0};
 }
 
 TrackerOutput PoseTracker::optimise(const DepthInput& input) {
@@ -373,7 +414,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   bool started = false;
   CheckOutcome check = CheckOutcome::kNone;
   if (!previous_) {
-    best = restart(input).result;
+    best = restart(input, kStartTurns.size()).result;
     started = true;
     recovering_ = true;
   } else {
@@ -398,22 +439,23 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   }
 
   scratch_.update(model_, best.params);
-  double conf = confidence(input, scratch_);
+  Explained explained = explain(input, scratch_);
   if (check_next_ && previous_) {
     // A suspected gross error: the tracked pose competes with the (re)start hypotheses on this
     // freshly segmented frame; a (re)start replaces it only when it explains more of the hand, so
     // a check cannot make good tracking worse by this measure.
-    const Fit fresh = restart(input);
-    check = fresh.confidence > conf ? CheckOutcome::kRestartWon : CheckOutcome::kTrackedKept;
+    const Fit fresh = restart(input, kCheckTurns);
+    check = fresh.explained.score() > explained.score() ? CheckOutcome::kRestartWon : CheckOutcome::kTrackedKept;
     if (check == CheckOutcome::kRestartWon) {
       best = fresh.result;
-      conf = fresh.confidence;
+      explained = fresh.explained;
       winner = -1;
       guided_won = false;
       before_previous_.reset();  // no velocity from the wrong pose to the restart
       previous_.reset();
     }
   }
+  const double conf = explained.confidence;
   watch_confidence(conf, check);
   low_confidence_run_ = conf < config_.lost_confidence ? low_confidence_run_ + 1 : 0;
   if (low_confidence_run_ >= config_.lost_frames && previous_) {
@@ -425,6 +467,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     recovering_ = true;
     auto out = describe(lost, best.energy, TrackingState::kRecovering);
     out.confidence = conf;
+    out.label_agreement = explained.label_agreement;
     out.winning_particle = winner;
     return out;
   } else if (conf >= config_.lost_confidence) {
@@ -437,12 +480,13 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   previous_ = best.params;
   auto out = describe(best.params, best.energy, recovering_ ? TrackingState::kRecovering : TrackingState::kTracking);
   out.confidence = conf;
+  out.label_agreement = explained.label_agreement;
   out.winning_particle = winner;
   out.detection_guided_won = guided_won;
   return out;
 }
 
-PoseTracker::Fit PoseTracker::restart(const DepthInput& input) {
+PoseTracker::Fit PoseTracker::restart(const DepthInput& input, size_t turns) {
   // The hypotheses are compared by confidence, not energy: E_sim has no notion of occlusion, so
   // a wrong pose that pushes the big palm Gaussians onto the visible surface can out-score the right
   // one (seen on fists), while it explains little of the hand's outline. No temporal prior: the
@@ -456,16 +500,18 @@ PoseTracker::Fit PoseTracker::restart(const DepthInput& input) {
   const bool out_of_plane = std::abs(input.finger_axis.z()) >= kOutOfPlaneAxisMinZ;
   for (bool along_axis_3d : {false, true}) {
     if (along_axis_3d && !out_of_plane) continue;
-    for (bool back : kStartBack) {
+    for (size_t t = 0; t < turns; ++t) {
+      const double turn = kStartTurns[t];
       for (bool closed : kStartClosed) {
         for (double offset : kStartRotations) {
-          const Start start{offset, closed, back, along_axis_3d};
+          const Start start{offset, closed, turn, along_axis_3d};
           const auto r = optimizer_.maximise(energy, frame, initial_pose(input, start), scratch_,
                                              config_.init_iterations);
           scratch_.update(model_, r.params);
-          const double c = confidence(input, scratch_);
-          if (c > best.confidence + 1e-9 || (c > best.confidence - 1e-9 && r.energy > best.result.energy)) {
-            best = Fit{r, c};
+          const Explained e = explain(input, scratch_);
+          const double c = e.score();
+          if (c > best.explained.score() + 1e-9 || (c > best.explained.score() - 1e-9 && r.energy > best.result.energy)) {
+            best = Fit{r, e};
           }
         }
       }

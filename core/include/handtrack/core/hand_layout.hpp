@@ -50,5 +50,11 @@ constexpr int part_label(int finger, int bone) {
   if (finger == kThumb) return kThumbMetacarpal + bone;
   return kIndexProximal + 2 * (finger - 1) + (bone == 0 ? 0 : 1);
 }
+// The finger a part label belongs to (Finger), or -1 for the palm and the background.
+constexpr int part_finger(int label) {
+  if (label < kThumbMetacarpal) return -1;
+  if (label <= kThumbDistal) return kThumb;
+  return kIndex + (label - kIndexProximal) / 2;
+}
 
 }  // namespace handtrack

@@ -66,7 +66,10 @@ struct TrackerConfig {
   // Late fusion: lambda, the label share of the common energy's E_sim (ours; the paper does not say
   // which energy compares the particles). Measured over 0 / 0.25 / 0.5: 0.25 was best.
   double fusion_label_weight = 0.25;
-  int init_iterations = 40;          // iterations for a (re)start from the open hand
+  // Iterations per (re)start hypothesis. 40 left the start of adbadd (palm view) 30 mm off for 40
+  // frames with the forest of all views; 80: the broadened benchmark 27.9 -> 26.1 mm (right hands,
+  // 3 seeds, 150 frames), the palm view 10.1 -> 9.6 mm.
+  int init_iterations = 80;
   double lost_confidence = 0.3;      // below this for `lost_frames` frames in a row: restart
   int lost_frames = 3;
   // Gross errors (issue 4; ours, the paper has no re-initialisation beyond Sec. 5's start): a
@@ -98,6 +101,8 @@ struct TrackerOutput {
   Eigen::Vector3d palm_normal = Eigen::Vector3d::Zero();  // out of the palm, camera frame
   double energy = 0.0;
   double confidence = 0.0;           // fraction of the hand's depth explained by the model, in [0, 1]
+  // With part labels: how far they agree with the fitted model (PoseTracker::Explained), else -1.
+  double label_agreement = -1.0;
   double pinch_distance_mm = 0.0;    // thumb tip to index tip, surface to surface
   double pinch_strength = 0.0;       // 1 = touching, 0 = apart (>= 40 mm)
   int winning_particle = -1;         // -1: a (re)start, not a particle
@@ -111,6 +116,13 @@ struct TrackerOutput {
   // a frame without one; 0 when there is no hand. Counts from 1 within one Tracker.
   uint32_t hand_id = 0;
 };
+
+// How well a fit explains the segmented hand, for choosing between fits (the (re)start hypotheses,
+// the tracked pose against a (re)start, one hand against the other): the confidence, times the
+// label agreement where there are part labels. Without the labels a hand fitted with its thumb on
+// its little finger's side explains the depth about as well as the right one (a right hand's back
+// fitted as a left hand's back: docs/TRACKER.md, "Every view").
+double fit_score(double confidence, double label_agreement);
 
 class PoseTracker {
  public:
@@ -135,22 +147,33 @@ class PoseTracker {
   struct Start {
     double in_plane_offset_rad = 0.0;  // turned about the camera axis away from the segmented axis
     bool closed = false;               // a fist instead of the open hand
-    bool back = false;                 // the back of the hand toward the camera instead of the palm
+    // Turned about the hand's finger axis: 0 the palm toward the camera, pi the back, +-pi/2 a side
+    // (the thumb's or the little finger's edge) toward it.
+    double turn_rad = 0.0;
     bool along_axis_3d = false;        // fingers along the segmented axis in 3D, not in the image plane
   };
   [[nodiscard]] PoseParams initial_pose(const DepthInput& input, const Start& start) const;
   // How much of the segmented hand the posed model explains, in [0, 1].
   [[nodiscard]] double confidence(const DepthInput& input, const PosedHand& hand) const;
+  struct Explained {
+    double confidence = 0.0;
+    // Of the labelled hand pixels the model explains, the share whose part label (Sec. 4.3) names
+    // the finger (or the palm) of the model Gaussian that explains them; -1 without labels.
+    double label_agreement = -1.0;
+    [[nodiscard]] double score() const { return fit_score(confidence, label_agreement); }
+  };
+  [[nodiscard]] Explained explain(const DepthInput& input, const PosedHand& hand) const;
 
  private:
   TrackerOutput describe(const PoseParams& params, double energy, TrackingState state);
   // A pose and how much of the segmented hand it explains.
   struct Fit {
     OptimizerResult result{PoseParams::Zero(), -1e300};
-    double confidence = -1.0;
+    Explained explained{-1.0, -1.0};
   };
-  // Sec. 5's start: every (re)start hypothesis optimised on `input`, the best by confidence.
-  Fit restart(const DepthInput& input);
+  // Sec. 5's start: the (re)start hypotheses of the first `turns` turns about the finger axis
+  // optimised on `input`, the best by confidence.
+  Fit restart(const DepthInput& input, size_t turns);
   // After a frame's fit: tracks the running confidence level and decides whether the next frame
   // checks the tracked pose against a (re)start.
   enum class CheckOutcome { kNone, kTrackedKept, kRestartWon };
