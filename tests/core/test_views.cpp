@@ -1,0 +1,104 @@
+// Every view (issue "Every hand, every view"): the shipped configuration (late fusion with the
+// shipped forest, handedness auto, 2 particles x 10 iterations) on one motion in each camera
+// arrangement of handtrack-synth, 120 frames, one seed not used while tuning (21), noise on.
+//
+// The bounds are what the tracker reaches now with some room, so that a change that loses a view
+// fails here; they are not the issue's goal (every view <= 20 mm, handedness >= 98 %), which the
+// back, side, fingers-away and head-mounted views still miss (docs/TRACKER.md, "Every view").
+#include "handtrack/core/part_forest.hpp"
+#include "handtrack/core/tracker.hpp"
+#include "handtrack/synth/synthetic_camera.hpp"
+#include "handtrack/synth/views.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+
+namespace handtrack {
+namespace {
+
+constexpr int kFrames = 120;
+constexpr uint64_t kSeed = 21;
+
+struct ViewCase {
+  synth::View view;
+  synth::Handedness hand;
+  double max_mean_mm;           // mean fingertip error over the frames with a pose
+  double min_handedness_share;  // of the frames with a pose, reported as the hand shown
+};
+
+struct ViewRun {
+  double mean_error_mm = 0.0;
+  int posed = 0;
+  int reported_as_shown = 0;
+};
+
+ViewRun track_view(const ViewCase& c, const PartForest& forest) {
+  synth::SynthOptions options;
+  options.motion = "pinch";
+  options.frames = kFrames;
+  options.seed = kSeed;
+  options.hand = c.hand;
+  options.view = c.view;
+  synth::SyntheticCamera camera(options);
+  TrackerConfig config;
+  config.mode = EnergyMode::kLateFusion;
+  Tracker tracker(config);
+  const Handedness shown = c.hand == synth::Handedness::kLeft ? Handedness::kLeft : Handedness::kRight;
+  ViewRun run;
+  double sum = 0.0;
+  synth::SynthFrame frame;
+  for (int i = 0; i < kFrames; ++i) {
+    camera.render(i, frame);
+    const TrackerOutput out = tracker.track(frame.depth, &forest);
+    if (out.state == TrackingState::kNoHand) continue;
+    ++run.posed;
+    run.reported_as_shown += out.handedness == shown ? 1 : 0;
+    double e = 0.0;
+    for (size_t t = 0; t < kNumFingers; ++t) e += (out.fingertips[t] - *frame.fingertips[t]).norm();
+    sum += e / kNumFingers;
+  }
+  run.mean_error_mm = run.posed > 0 ? sum / run.posed : 1e9;
+  return run;
+}
+
+class EveryView : public ::testing::TestWithParam<ViewCase> {};
+
+TEST_P(EveryView, PinchIsTrackedAsTheHandItIs) {
+  const ViewCase& c = GetParam();
+  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const ViewRun run = track_view(c, forest);
+  const std::string name = std::string(synth::view_name(c.view)) + " " + std::string(synth::handedness_name(c.hand));
+  std::printf("%s: %.1f mm, %d of %d frames posed, %d as the hand shown\n", name.c_str(), run.mean_error_mm, run.posed,
+              kFrames, run.reported_as_shown);
+  EXPECT_GE(run.posed, kFrames * 95 / 100) << name << ": a pose in at least 95 % of the frames";
+  EXPECT_LE(run.mean_error_mm, c.max_mean_mm) << name;
+  EXPECT_GE(run.reported_as_shown, c.min_handedness_share * run.posed) << name << ": handedness";
+}
+
+std::string case_name(const ::testing::TestParamInfo<ViewCase>& info) {
+  std::string name = std::string(synth::view_name(info.param.view)) + "_" +
+                     std::string(synth::handedness_name(info.param.hand));
+  for (char& ch : name) {
+    if (ch == '-') ch = '_';
+  }
+  return name;
+}
+
+// Measured at seed 21 when this test was written: palm 5.6 (right) and 4.2 mm (left), back 19.0 mm
+// with 74 % of the frames reported as the right hand, side 4.6, fingers-toward 9.0, fingers-away
+// 15.6 (left), head-mounted 39.6 mm; every other view 100 % the hand shown.
+INSTANTIATE_TEST_SUITE_P(
+    ShippedConfiguration, EveryView,
+    ::testing::Values(ViewCase{synth::View::kPalm, synth::Handedness::kRight, 12.0, 0.98},
+                      ViewCase{synth::View::kPalm, synth::Handedness::kLeft, 12.0, 0.98},
+                      ViewCase{synth::View::kBack, synth::Handedness::kRight, 30.0, 0.6},
+                      ViewCase{synth::View::kSide, synth::Handedness::kRight, 15.0, 0.98},
+                      ViewCase{synth::View::kFingersToward, synth::Handedness::kRight, 20.0, 0.98},
+                      ViewCase{synth::View::kFingersAway, synth::Handedness::kLeft, 25.0, 0.98},
+                      ViewCase{synth::View::kHeadMounted, synth::Handedness::kRight, 55.0, 0.98}),
+    case_name);
+
+}  // namespace
+}  // namespace handtrack
