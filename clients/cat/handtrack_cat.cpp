@@ -1,4 +1,5 @@
-// handtrack-cat: print poses from handtrackd's shared memory, one JSON object a line.
+// handtrack-cat: print frames (every hand of each) from handtrackd's shared memory, one JSON object
+// a line.
 //
 // The objects are clients/json/pose_json.hpp's (SPEC.md "handtrack-cat"), as handtrack-ws sends.
 #include <handtrack/client.hpp>
@@ -16,7 +17,7 @@
 
 namespace {
 
-using handtrack::json::format_pose;
+using handtrack::json::format_frame;
 using handtrack::json::format_status;
 using handtrack::json::Line;
 
@@ -25,7 +26,7 @@ int fail(const std::string& message) { return handtrack::report_error("handtrack
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Print hand poses from handtrackd's shared memory, one JSON object a line."};
+  CLI::App app{"Print hand poses from handtrackd's shared memory, one JSON object per frame (its hands) a line."};
   std::string shm_name = HANDTRACK_DEFAULT_SHM_NAME;
   std::uint64_t count = 0;
   double timeout_s = -1;
@@ -34,17 +35,17 @@ int main(int argc, char** argv) {
   bool smooth = false;
   bool from_start = false;
   app.add_option("--shm-name", shm_name, "shared-memory object name")->capture_default_str();
-  app.add_option("--count", count, "stop after N poses (0: never)")->check(CLI::NonNegativeNumber);
+  app.add_option("--count", count, "stop after N frames (0: never)")->check(CLI::NonNegativeNumber);
   app.add_option("--timeout", timeout_s,
-                 "give up (exit 1) when no pose arrives for S seconds, including waiting for "
+                 "give up (exit 1) when no frame arrives for S seconds, including waiting for "
                  "the daemon to appear (default: wait forever)")
       ->check(CLI::PositiveNumber);
-  app.add_flag("--latest", latest_only, "print only the newest pose when several are waiting");
+  app.add_flag("--latest", latest_only, "print only the newest frame when several are waiting");
   app.add_flag("--status", status_only, "print the daemon's status and statistics once and exit");
   app.add_flag("--from-start", from_start,
-               "begin with the oldest pose still in the ring instead of the next new one");
+               "begin with the oldest frame still in the ring instead of the next new one");
   app.add_flag("--smooth", smooth,
-               "smooth joints, fingertips and palm with the client library's One Euro filter (its defaults; "
+               "smooth each hand's joints, fingertips and palm with the client library's One Euro filter (its defaults; "
                "docs/FILTER.md)");
   if (const auto exit_code = handtrack::parse_command_line(app, argc, argv, "handtrack-cat", 1)) return *exit_code;
   std::signal(SIGPIPE, SIG_IGN);  // a closed pipe (| head) ends us through fwrite's error
@@ -77,7 +78,7 @@ int main(int argc, char** argv) {
   }
 
   if (from_start) client.rewind();
-  handtrack_pose pose{};
+  handtrack_frame frame{};
   handtrack::PoseFilter filter;
   std::uint64_t printed = 0;
   int last_trouble = HANDTRACK_OK;
@@ -85,11 +86,11 @@ int main(int argc, char** argv) {
   while (count == 0 || printed < count) {
     const auto wait_for = has_timeout ? std::max(deadline - Clock::now(), Clock::duration::zero())
                                       : std::chrono::duration_cast<Clock::duration>(std::chrono::seconds(1));
-    const int st = latest_only ? client.wait_latest(pose, wait_for) : client.wait_next(pose, wait_for);
+    const int st = latest_only ? client.wait_latest(frame, wait_for) : client.wait_next(frame, wait_for);
     if (st == HANDTRACK_OK) {
       last_trouble = HANDTRACK_OK;
-      if (smooth) filter.apply(pose);
-      format_pose(pose, client.missed(), line);
+      if (smooth) filter.apply(frame);
+      format_frame(frame, client.missed(), line);
       if (std::fwrite(line.text().data(), 1, line.text().size(), stdout) != line.text().size() ||
           std::fflush(stdout) != 0) {
         return 0;  // the reader of our output went away
@@ -108,7 +109,7 @@ int main(int argc, char** argv) {
     }
     if (has_timeout && Clock::now() >= deadline) {
       char message[160];
-      std::snprintf(message, sizeof message, "no pose within %g s on '/%s'%s%s%s", timeout_s,
+      std::snprintf(message, sizeof message, "no frame within %g s on '/%s'%s%s%s", timeout_s,
                     shm_name.c_str(), last_trouble != HANDTRACK_OK ? " (" : "",
                     last_trouble != HANDTRACK_OK ? handtrack_strerror(last_trouble) : "",
                     last_trouble != HANDTRACK_OK ? ")" : "");

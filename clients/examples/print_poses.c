@@ -1,4 +1,5 @@
-/* print_poses: the smallest C client. Prints the frame and index fingertip of each new pose.
+/* print_poses: the smallest C client. Prints each new frame with every hand in it: its id,
+ * handedness, state and index fingertip.
  * Build against the installed library:  cc print_poses.c $(pkg-config --cflags --libs handtrack)
  * Usage: print_poses [SHM_NAME [COUNT]] */
 #include <handtrack/client.h>
@@ -15,21 +16,27 @@ int main(int argc, char** argv) {
     fprintf(stderr, "print_poses: %s (%s)\n", handtrack_strerror(status), handtrack_error_detail());
     return 1;
   }
-  handtrack_pose pose;
+  handtrack_frame frame;
   long printed = 0;
   while (printed < count) {
-    status = handtrack_wait_next(client, &pose, 2000000000LL); /* 2 s */
+    status = handtrack_wait_next(client, &frame, 2000000000LL); /* 2 s */
     if (status == HANDTRACK_OK) {
-      printf("frame %llu %s index tip %.1f %.1f %.1f mm (missed %llu)\n",
-             (unsigned long long)pose.frame, handtrack_state_name(pose.state),
-             pose.fingertips_mm[1][0], pose.fingertips_mm[1][1], pose.fingertips_mm[1][2],
+      printf("frame %llu (missed %llu):", (unsigned long long)frame.frame,
              (unsigned long long)handtrack_missed(client));
+      if (frame.hand_count == 0) printf(" no hand");
+      for (uint32_t i = 0; i < frame.hand_count; ++i) {
+        const handtrack_hand* hand = &frame.hands[i];
+        printf("%s hand %u %s %s index tip %.1f %.1f %.1f mm", i > 0 ? ";" : "", (unsigned)hand->hand_id,
+               handtrack_handedness_name(hand->handedness), handtrack_state_name(hand->state),
+               hand->fingertips_mm[1][0], hand->fingertips_mm[1][1], hand->fingertips_mm[1][2]);
+      }
+      printf("\n");
       ++printed;
     } else if (status < 0 && status != HANDTRACK_ERR_WRITER_DEAD && status != HANDTRACK_ERR_WRITER_STOPPED) {
-      fprintf(stderr, "print_poses: %s\n", handtrack_strerror(status));
+      fprintf(stderr, "print_poses: %s (%s)\n", handtrack_strerror(status), handtrack_error_detail());
       break;
     } else if (status == HANDTRACK_TIMEOUT) {
-      fprintf(stderr, "print_poses: no pose for 2 s\n");
+      fprintf(stderr, "print_poses: no frame for 2 s\n");
       break;
     }
   }

@@ -1,11 +1,13 @@
 #pragma once
-// One pose (or the writer status) as one line of JSON: what handtrack-cat prints and handtrack-ws
-// sends (SPEC.md "handtrack-cat"): frame, epoch, state, capture_ns, publish_ns, confidence,
-// energy, params (26), joints (21 x [x,y,z] mm), fingertips (5 x [x,y,z] mm, thumb..little),
-// pinch {distance_mm, strength}, missed; plus timings_ms, palm and hand_scale.
+// One frame (or the writer status) as one line of JSON: what handtrack-cat prints and handtrack-ws
+// sends (SPEC.md "handtrack-cat", ABI version 2): frame, epoch, capture_ns, publish_ns, missed,
+// timings_ms, and hands: a list (empty when no hand is seen) of objects with hand_id, handedness
+// ("left"/"right"), handedness_confidence, state, confidence, energy, optimize_ms, params (26),
+// joints (21 x [x,y,z] mm), fingertips (5 x [x,y,z] mm, thumb..little), pinch {distance_mm,
+// strength}, palm and hand_scale.
 // Numbers are printed with std::to_chars (shortest text that reads back to the same float or
 // double); a non-finite value is printed as null (JSON has no NaN). No allocation once a Line's
-// text has grown to a pose's size.
+// text has grown to a frame's size.
 //
 // Thread roles: reentrant: a Line belongs to one thread at a time.
 #include <handtrack/client.h>
@@ -62,34 +64,49 @@ class Line {
   std::string text_;
 };
 
-inline void format_pose(const handtrack_pose& p, std::uint64_t missed, Line& out) {
+inline void format_hand(const handtrack_hand& h, Line& out) {
+  out.raw("{");
+  out.key("hand_id"), out.number(h.hand_id), out.raw(",");
+  out.key("handedness"), out.raw("\""), out.raw(handtrack_handedness_name(h.handedness)), out.raw("\",");
+  out.key("handedness_confidence"), out.number(h.handedness_confidence), out.raw(",");
+  out.key("state"), out.raw("\""), out.raw(handtrack_state_name(h.state)), out.raw("\",");
+  out.key("confidence"), out.number(h.confidence), out.raw(",");
+  out.key("energy"), out.number(h.energy), out.raw(",");
+  out.key("optimize_ms"), out.number(h.optimize_ms), out.raw(",");
+  out.key("params"), out.array(h.params, HANDTRACK_NUM_PARAMS), out.raw(",");
+  out.key("joints"), out.points<float, HANDTRACK_NUM_JOINTS>(h.joints_mm), out.raw(",");
+  out.key("fingertips"), out.points<float, HANDTRACK_NUM_FINGERTIPS>(h.fingertips_mm), out.raw(",");
+  out.raw("\"pinch\":{");
+  out.key("distance_mm"), out.number(h.pinch_distance_mm), out.raw(",");
+  out.key("strength"), out.number(h.pinch_strength), out.raw("},");
+  out.raw("\"palm\":{");
+  out.key("center_mm"), out.array(h.palm_center_mm, 3), out.raw(",");
+  out.key("normal"), out.array(h.palm_normal, 3), out.raw("},");
+  out.raw("\"hand_scale\":{");
+  out.key("length"), out.number(h.hand_scale[0]), out.raw(",");
+  out.key("width"), out.number(h.hand_scale[1]), out.raw(",");
+  out.key("sigma"), out.number(h.hand_scale[2]), out.raw("}}");
+}
+
+inline void format_frame(const handtrack_frame& f, std::uint64_t missed, Line& out) {
   out.text().clear();
   out.raw("{");
-  out.key("frame"), out.number(p.frame), out.raw(",");
-  out.key("epoch"), out.number(p.epoch), out.raw(",");
-  out.key("state"), out.raw("\""), out.raw(handtrack_state_name(p.state)), out.raw("\",");
-  out.key("capture_ns"), out.number(p.capture_ns), out.raw(",");
-  out.key("publish_ns"), out.number(p.publish_ns), out.raw(",");
-  out.key("confidence"), out.number(p.confidence), out.raw(",");
-  out.key("energy"), out.number(p.energy), out.raw(",");
-  out.key("params"), out.array(p.params, HANDTRACK_NUM_PARAMS), out.raw(",");
-  out.key("joints"), out.points<float, HANDTRACK_NUM_JOINTS>(p.joints_mm), out.raw(",");
-  out.key("fingertips"), out.points<float, HANDTRACK_NUM_FINGERTIPS>(p.fingertips_mm), out.raw(",");
-  out.raw("\"pinch\":{");
-  out.key("distance_mm"), out.number(p.pinch_distance_mm), out.raw(",");
-  out.key("strength"), out.number(p.pinch_strength), out.raw("},");
+  out.key("frame"), out.number(f.frame), out.raw(",");
+  out.key("epoch"), out.number(f.epoch), out.raw(",");
+  out.key("capture_ns"), out.number(f.capture_ns), out.raw(",");
+  out.key("publish_ns"), out.number(f.publish_ns), out.raw(",");
   out.raw("\"timings_ms\":{");
-  out.key("grab"), out.number(p.grab_ms), out.raw(",");
-  out.key("preprocess"), out.number(p.preprocess_ms), out.raw(",");
-  out.key("optimize"), out.number(p.optimize_ms), out.raw(",");
-  out.key("publish"), out.number(p.publish_ms), out.raw("},");
-  out.raw("\"palm\":{");
-  out.key("center_mm"), out.array(p.palm_center_mm, 3), out.raw(",");
-  out.key("normal"), out.array(p.palm_normal, 3), out.raw("},");
-  out.raw("\"hand_scale\":{");
-  out.key("length"), out.number(p.hand_scale[0]), out.raw(",");
-  out.key("width"), out.number(p.hand_scale[1]), out.raw(",");
-  out.key("sigma"), out.number(p.hand_scale[2]), out.raw("},");
+  out.key("grab"), out.number(f.grab_ms), out.raw(",");
+  out.key("preprocess"), out.number(f.preprocess_ms), out.raw(",");
+  out.key("optimize"), out.number(f.optimize_ms), out.raw(",");
+  out.key("publish"), out.number(f.publish_ms), out.raw("},");
+  out.key("hands"), out.raw("[");
+  const std::uint32_t count = f.hand_count < HANDTRACK_MAX_HANDS ? f.hand_count : HANDTRACK_MAX_HANDS;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    if (i > 0) out.raw(",");
+    format_hand(f.hands[i], out);
+  }
+  out.raw("],");
   out.key("missed"), out.number(missed);
   out.raw("}\n");
 }

@@ -1,15 +1,16 @@
 // handtrack-ws: the browser bridge (SPEC.md "Programs", docs/WEBSOCKET.md). It reads the pose ring
 // like any client and serves, on 127.0.0.1:8765 unless told otherwise:
 //   GET /          a page that draws the live hand (page/index.html, built in)
-//   GET /poses     a WebSocket: one text message per pose, the JSON object handtrack-cat prints
+//   GET /poses     a WebSocket: one text message per frame, the JSON object handtrack-cat prints
+//                  (every hand of the frame in "hands")
 //
 // A WebSocket whose Origin is not on the allow-list (the page's own origins, plus --allow-origin)
 // is refused with 403: a web page elsewhere must not read the user's hands. A slow browser never
-// slows the reader or the other browsers: each connection writes the newest pose when its
-// previous write has completed, and drops what came in between. Messages are bounded (a pose is
-// about 5 KB; a browser may send at most 1 KB, which is read and ignored), and so are connections.
+// slows the reader or the other browsers: each connection writes the newest frame when its
+// previous write has completed, and drops what came in between. Messages are bounded (a frame is
+// about 5 KB per hand; a browser may send at most 1 KB, which is read and ignored), and so are connections.
 //
-// Thread roles: two threads. The reader thread turns poses from the ring into messages and posts
+// Thread roles: two threads. The reader thread turns frames from the ring into messages and posts
 // each to the network thread; the network thread (Boost.Asio's io_context) runs every connection.
 // Nothing else is shared.
 #include <handtrack/client.hpp>
@@ -222,13 +223,13 @@ class Listener : public std::enable_shared_from_this<Listener> {
   const std::vector<std::string>& origins_;
 };
 
-// The reader thread: the newest pose of the ring, as a message, to the network thread. Waits for
+// The reader thread: the newest frame of the ring, as a message, to the network thread. Waits for
 // the daemon to appear and follows its restarts (the client library reattaches by itself).
 void read_poses(const Options& options, net::io_context& io, Hub& hub, const std::atomic<bool>& stop) {
   handtrack::Client client;
   handtrack::PoseFilter filter;
   handtrack::json::Line line;
-  handtrack_pose pose{};
+  handtrack_frame frame{};
   bool reported = false;
   while (!stop.load(std::memory_order_relaxed)) {
     if (!client.is_open()) {
@@ -241,9 +242,9 @@ void read_poses(const Options& options, net::io_context& io, Hub& hub, const std
       std::fprintf(stderr, "%s: reading poses from /%s\n", kProgram, options.shm_name.c_str());
       reported = false;
     }
-    if (client.wait_latest(pose, std::chrono::milliseconds(200)) != HANDTRACK_OK) continue;
-    if (options.smooth) filter.apply(pose);
-    handtrack::json::format_pose(pose, client.missed(), line);
+    if (client.wait_latest(frame, std::chrono::milliseconds(200)) != HANDTRACK_OK) continue;
+    if (options.smooth) filter.apply(frame);
+    handtrack::json::format_frame(frame, client.missed(), line);
     auto message = std::make_shared<const std::string>(line.text());
     net::post(io, [&hub, message] { hub.broadcast(message); });
   }

@@ -63,10 +63,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::vector<double> pipeline, wake, total;
-  handtrack_pose pose{};
+  handtrack_frame frame{};
   int seen = 0;
   while (static_cast<int>(total.size()) < count) {
-    st = client.wait_next(pose, std::chrono::nanoseconds(static_cast<int64_t>(timeout_s * 1e9)));
+    st = client.wait_next(frame, std::chrono::nanoseconds(static_cast<int64_t>(timeout_s * 1e9)));
     const int64_t read_ns = now_ns();
     if ((st == HANDTRACK_ERR_WRITER_STOPPED || st == HANDTRACK_ERR_WRITER_DEAD || st == HANDTRACK_TIMEOUT) &&
         seen == 0 && read_ns < open_deadline + static_cast<int64_t>(timeout_s * 1e9)) {
@@ -77,9 +77,9 @@ int main(int argc, char** argv) {
       return 1;
     }
     if (seen++ < skip) continue;
-    pipeline.push_back(static_cast<double>(pose.publish_ns - pose.capture_ns) * 1e-6);
-    wake.push_back(static_cast<double>(read_ns - pose.publish_ns) * 1e-6);
-    total.push_back(static_cast<double>(read_ns - pose.capture_ns) * 1e-6);
+    pipeline.push_back(static_cast<double>(frame.publish_ns - frame.capture_ns) * 1e-6);
+    wake.push_back(static_cast<double>(read_ns - frame.publish_ns) * 1e-6);
+    total.push_back(static_cast<double>(read_ns - frame.capture_ns) * 1e-6);
   }
   std::printf("{\"records\":%zu,\"missed\":%llu,%s,%s,%s}\n", total.size(),
               static_cast<unsigned long long>(client.missed_total()), summary("pipeline_ms", pipeline).c_str(),

@@ -26,7 +26,7 @@ struct Frame {
   bool resolution_changed = false;     // first frame of a new resolution: the tracker restarts
   TrackerOutput output;
   HandScale scale;
-  uint64_t seq = 0;                    // daemon frame number (PoseRecord::frame)
+  uint64_t seq = 0;                    // daemon frame number (FrameRecord::frame)
   int64_t capture_ns = 0;
   int64_t grab_end_ns = 0;
   int64_t preprocess_start_ns = 0;

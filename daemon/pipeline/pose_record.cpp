@@ -9,12 +9,14 @@ namespace {
 template <typename Array>
 constexpr int extent = static_cast<int>(std::extent_v<Array>);
 
-using Record = ipc::PoseRecord;
-static_assert(extent<decltype(Record::params)> == kNumPoseParams, "PoseRecord::params: one per pose parameter");
-static_assert(extent<decltype(Record::joints_mm)> == kNumJoints, "PoseRecord::joints_mm: one per joint");
-static_assert(extent<decltype(Record::fingertips_mm)> == kNumFingers, "PoseRecord::fingertips_mm: one per finger");
-static_assert(std::is_same_v<std::remove_extent_t<decltype(Record::params)>, PoseParams::Scalar>,
+using Hand = ipc::HandRecord;
+static_assert(extent<decltype(Hand::params)> == kNumPoseParams, "HandRecord::params: one per pose parameter");
+static_assert(extent<decltype(Hand::joints_mm)> == kNumJoints, "HandRecord::joints_mm: one per joint");
+static_assert(extent<decltype(Hand::fingertips_mm)> == kNumFingers, "HandRecord::fingertips_mm: one per finger");
+static_assert(std::is_same_v<std::remove_extent_t<decltype(Hand::params)>, PoseParams::Scalar>,
               "params travel at the optimizer's precision");
+static_assert(std::is_same_v<decltype(Hand::hand_id), decltype(TrackerOutput::hand_id)>,
+              "hand ids cross unchanged (0: no hand on both sides)");
 
 constexpr bool same(TrackingState core, ipc::TrackingState ipc) {
   return static_cast<int>(core) == static_cast<int>(ipc);
@@ -34,20 +36,41 @@ ipc::TrackingState to_ipc(TrackingState state) {
   return static_cast<ipc::TrackingState>(static_cast<int>(state));
 }
 
-void fill_pose(const TrackerOutput& o, const HandScale& scale, ipc::PoseRecord& p) {
-  p.state = static_cast<int32_t>(to_ipc(o.state));
-  p.confidence = static_cast<float>(o.confidence);
-  p.energy = static_cast<float>(o.energy);
-  for (int i = 0; i < kNumPoseParams; ++i) p.params[i] = o.params[i];
-  for (int j = 0; j < kNumJoints; ++j) put(o.joints[static_cast<size_t>(j)], p.joints_mm[j]);
-  for (int t = 0; t < kNumFingers; ++t) put(o.fingertips[static_cast<size_t>(t)], p.fingertips_mm[t]);
-  put(o.palm_centre, p.palm_center_mm);
-  put(o.palm_normal, p.palm_normal);
-  p.pinch_distance_mm = static_cast<float>(o.pinch_distance_mm);
-  p.pinch_strength = static_cast<float>(o.pinch_strength);
-  p.hand_scale[0] = static_cast<float>(scale.length);
-  p.hand_scale[1] = static_cast<float>(scale.width);
-  p.hand_scale[2] = static_cast<float>(scale.sigma);
+ipc::Handedness to_ipc(Handedness hand) {
+  // The values differ (core: right 0, left 1; the ABI: 0 is "unknown"), so each is named.
+  switch (hand) {
+    case Handedness::kLeft: return ipc::Handedness::kLeft;
+    case Handedness::kRight: return ipc::Handedness::kRight;
+  }
+  return ipc::Handedness::kUnknown;
+}
+
+void fill_hands(const TrackerOutput& o, const HandScale& scale, float optimize_ms, ipc::FrameRecord& record) {
+  for (Hand& h : record.hands) h = Hand{};
+  if (o.state == TrackingState::kNoHand) {
+    record.hand_count = 0;
+    return;
+  }
+  // The tracker follows one hand; a second one (issue 14) becomes hands[1].
+  record.hand_count = 1;
+  Hand& h = record.hands[0];
+  h.hand_id = o.hand_id;
+  h.handedness = static_cast<int32_t>(to_ipc(o.handedness));
+  h.handedness_confidence = static_cast<float>(o.handedness_confidence);
+  h.state = static_cast<int32_t>(to_ipc(o.state));
+  h.confidence = static_cast<float>(o.confidence);
+  h.energy = static_cast<float>(o.energy);
+  h.optimize_ms = optimize_ms;
+  for (int i = 0; i < kNumPoseParams; ++i) h.params[i] = o.params[i];
+  for (int j = 0; j < kNumJoints; ++j) put(o.joints[static_cast<size_t>(j)], h.joints_mm[j]);
+  for (int t = 0; t < kNumFingers; ++t) put(o.fingertips[static_cast<size_t>(t)], h.fingertips_mm[t]);
+  put(o.palm_centre, h.palm_center_mm);
+  put(o.palm_normal, h.palm_normal);
+  h.pinch_distance_mm = static_cast<float>(o.pinch_distance_mm);
+  h.pinch_strength = static_cast<float>(o.pinch_strength);
+  h.hand_scale[0] = static_cast<float>(scale.length);
+  h.hand_scale[1] = static_cast<float>(scale.width);
+  h.hand_scale[2] = static_cast<float>(scale.sigma);
 }
 
 }  // namespace handtrack::daemon

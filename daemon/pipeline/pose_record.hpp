@@ -1,17 +1,21 @@
 #pragma once
-// The core -> ipc seam: one frame's TrackerOutput as the PoseRecord clients read. The two
-// vocabularies (core's TrackingState and array sizes, the C API's handtrack_tracking_state and
-// HANDTRACK_NUM_*) meet here only; pose_record.cpp static_asserts that they agree.
+// The core -> ipc seam: one frame's TrackerOutput as the hands of the FrameRecord clients read. The
+// two vocabularies (core's TrackingState, Handedness and array sizes, the C API's
+// handtrack_tracking_state, handtrack_handedness and HANDTRACK_NUM_*) meet here only;
+// pose_record.cpp static_asserts where they agree and converts where they differ.
 #include "handtrack/core/tracker.hpp"
 #include "handtrack/ipc/pose_record.hpp"
 
 namespace handtrack::daemon {
 
 ipc::TrackingState to_ipc(TrackingState state);
+ipc::Handedness to_ipc(Handedness hand);
 
-// Fills the pose fields of `record` (state, confidence, energy, params, joints, fingertips, palm,
-// pinch, hand scale). Frame number and timings are the publisher's; epoch and publish_ns the
-// ring writer's. Allocates nothing.
-void fill_pose(const TrackerOutput& output, const HandScale& scale, ipc::PoseRecord& record);
+// Fills the hands of `record` from the tracker's output: hand_count 0 (hands[] zero) when it sees
+// no hand (SPEC.md: "hands" empty), else hand 0 with its id, handedness, state, confidence,
+// energy, params, joints, fingertips, palm, pinch, hand scale and `optimize_ms`. The frame's own
+// fields (frame number, timings) are the publisher's; epoch and publish_ns the ring writer's.
+// Allocates nothing.
+void fill_hands(const TrackerOutput& output, const HandScale& scale, float optimize_ms, ipc::FrameRecord& record);
 
 }  // namespace handtrack::daemon

@@ -1,6 +1,6 @@
 #pragma once
-// PublishStage: the last stage. Writes one frame's pose into the ring (the one record of the
-// frame, stamped with its stage timings), counts skipped and empty frames, feeds the interval
+// PublishStage: the last stage. Writes one frame into the ring (its record: the frame's hands,
+// stamped with its stage timings; no hand seen: hand_count 0), counts skipped and empty frames, feeds the interval
 // statistics, and logs tracking-state changes at most once a second.
 //
 // Thread roles: thread-bound: step() from the publish thread (or the single thread).
@@ -28,7 +28,7 @@ class PublishStage {
   PipelineTally& tally_;
   StageWatch& watch_;
   IntervalStats& stats_;
-  ipc::PoseRecord record_{};
+  ipc::FrameRecord record_{};  // every field is set per frame (fill_hands clears the hands)
   int32_t logged_state_ = -1;
   uint64_t state_changes_ = 0;
   int64_t state_logged_ns_ = 0;

@@ -56,17 +56,17 @@ int handtrack_open(const char* shm_name, handtrack_client** out) {
 
 void handtrack_close(handtrack_client* client) { delete client; }
 
-int handtrack_latest(handtrack_client* client, handtrack_pose* out) {
+int handtrack_latest(handtrack_client* client, handtrack_frame* out) {
   if (client == nullptr || out == nullptr) return HANDTRACK_ERR_INVALID_ARGUMENT;
   return remember(client, client->reader.latest(*out));
 }
 
-int handtrack_wait_next(handtrack_client* client, handtrack_pose* out, int64_t timeout_ns) {
+int handtrack_wait_next(handtrack_client* client, handtrack_frame* out, int64_t timeout_ns) {
   if (client == nullptr || out == nullptr) return HANDTRACK_ERR_INVALID_ARGUMENT;
   return remember(client, client->reader.wait_next(*out, std::chrono::nanoseconds(timeout_ns)));
 }
 
-int handtrack_wait_latest(handtrack_client* client, handtrack_pose* out, int64_t timeout_ns) {
+int handtrack_wait_latest(handtrack_client* client, handtrack_frame* out, int64_t timeout_ns) {
   if (client == nullptr || out == nullptr) return HANDTRACK_ERR_INVALID_ARGUMENT;
   return remember(client, client->reader.wait_latest(*out, std::chrono::nanoseconds(timeout_ns)));
 }
@@ -93,16 +93,16 @@ int handtrack_writer_status_get(handtrack_client* client, handtrack_writer_statu
 const char* handtrack_strerror(int status) {
   switch (status) {
     case HANDTRACK_OK: return "success";
-    case HANDTRACK_TIMEOUT: return "no new pose within the timeout";
-    case HANDTRACK_NO_RECORD: return "the daemon has not published any pose yet";
+    case HANDTRACK_TIMEOUT: return "no new frame within the timeout";
+    case HANDTRACK_NO_RECORD: return "the daemon has not published any frame yet";
     case HANDTRACK_ERR_INVALID_ARGUMENT: return "invalid argument";
     case HANDTRACK_ERR_NOT_FOUND: return "no handtrack shared memory with that name (is handtrackd running?)";
     case HANDTRACK_ERR_PERMISSION: return "permission denied opening the handtrack shared memory (is this user in the daemon's group?)";
     case HANDTRACK_ERR_NOT_READY: return "the handtrack shared memory is still being initialized";
     case HANDTRACK_ERR_BAD_MAGIC: return "not a handtrack shared-memory segment (wrong magic)";
     case HANDTRACK_ERR_BAD_ENDIANNESS: return "the segment was written with the other byte order";
-    case HANDTRACK_ERR_BAD_VERSION: return "the daemon uses a different ABI version than this client library";
-    case HANDTRACK_ERR_BAD_RECORD_SIZE: return "the daemon's pose record size differs from this client library's";
+    case HANDTRACK_ERR_BAD_VERSION: return "the daemon uses a different ABI version than this client library (see handtrack_error_detail)";
+    case HANDTRACK_ERR_BAD_RECORD_SIZE: return "the daemon's frame record size differs from this client library's";
     case HANDTRACK_ERR_BAD_LAYOUT: return "the segment header is inconsistent (sizes or capacity)";
     case HANDTRACK_ERR_TRUNCATED: return "the shared-memory segment is smaller than its header says (truncated)";
     case HANDTRACK_ERR_WRITER_DEAD: return "the daemon is not alive (heartbeat stale)";
@@ -125,6 +125,14 @@ const char* handtrack_state_name(int32_t tracking_state) {
   }
 }
 
+const char* handtrack_handedness_name(int32_t handedness) {
+  switch (handedness) {
+    case HANDTRACK_HANDEDNESS_LEFT: return "left";
+    case HANDTRACK_HANDEDNESS_RIGHT: return "right";
+    default: return "unknown";
+  }
+}
+
 const char* handtrack_device_state_name(int32_t device_state) {
   switch (device_state) {
     case HANDTRACK_DEVICE_STOPPED: return "stopped";
@@ -137,7 +145,8 @@ const char* handtrack_device_state_name(int32_t device_state) {
 }
 
 uint32_t handtrack_abi_version(void) { return HANDTRACK_ABI_VERSION; }
-size_t handtrack_pose_size(void) { return sizeof(handtrack_pose); }
+size_t handtrack_frame_size(void) { return sizeof(handtrack_frame); }
+size_t handtrack_hand_size(void) { return sizeof(handtrack_hand); }
 size_t handtrack_writer_status_size(void) { return sizeof(handtrack_writer_status); }
 
 }  // extern "C"

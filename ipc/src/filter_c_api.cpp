@@ -1,20 +1,27 @@
 // The pose filter of the C API (handtrack/client.h, handtrack_filter_*): a One Euro filter
-// (one_euro.hpp) on every point of a pose, reset where the pose sequence breaks.
+// (one_euro.hpp) on every point of every hand of a frame, each hand followed by its hand_id and
+// reset where its sequence of poses breaks.
 #include "one_euro.hpp"
 
 #include <handtrack/client.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <new>
 
-struct handtrack_filter {
-  handtrack_filter_params params{};
-  handtrack::ipc::detail::OneEuroParams euro{};
-  std::array<handtrack::ipc::detail::OneEuroPoint, HANDTRACK_NUM_JOINTS> joints;
-  std::array<handtrack::ipc::detail::OneEuroPoint, HANDTRACK_NUM_FINGERTIPS> tips;
-  handtrack::ipc::detail::OneEuroPoint palm_center;
-  handtrack::ipc::detail::OneEuroPoint palm_normal;
+namespace {
+
+using handtrack::ipc::detail::OneEuroParams;
+using handtrack::ipc::detail::OneEuroPoint;
+
+// The filter of one hand: its points and where its sequence of poses stands.
+struct HandFilter {
+  uint32_t hand_id = 0;  // 0: free
+  std::array<OneEuroPoint, HANDTRACK_NUM_JOINTS> joints;
+  std::array<OneEuroPoint, HANDTRACK_NUM_FINGERTIPS> tips;
+  OneEuroPoint palm_center;
+  OneEuroPoint palm_normal;
   bool primed = false;
   uint64_t epoch = 0;
   int64_t last_capture_ns = 0;
@@ -27,27 +34,74 @@ struct handtrack_filter {
     primed = false;
   }
 
-  void apply(handtrack_pose& pose) noexcept {
-    const double dt_s = primed ? static_cast<double>(pose.capture_ns - last_capture_ns) * 1e-9 : 0.0;
-    // A new writer, a gap, time going backwards or no tracked hand: start afresh (the pose passes
+  void apply(handtrack_hand& hand, uint64_t frame_epoch, int64_t capture_ns, const handtrack_filter_params& params,
+             const OneEuroParams& euro) noexcept {
+    const double dt_s = primed ? static_cast<double>(capture_ns - last_capture_ns) * 1e-9 : 0.0;
+    // A new writer, a gap, time going backwards or no tracked hand: start afresh (the hand passes
     // through unchanged, and the next tracked pose primes the filter).
-    if (!primed || pose.epoch != epoch || dt_s <= 0.0 || dt_s > params.max_gap_s ||
-        pose.state != HANDTRACK_STATE_TRACKING) {
+    if (!primed || frame_epoch != epoch || dt_s <= 0.0 || dt_s > params.max_gap_s ||
+        hand.state != HANDTRACK_STATE_TRACKING) {
       reset();
     }
-    if (pose.state != HANDTRACK_STATE_TRACKING) return;
-    for (int j = 0; j < HANDTRACK_NUM_JOINTS; ++j) joints[j].filter(pose.joints_mm[j], dt_s, euro);
-    for (int t = 0; t < HANDTRACK_NUM_FINGERTIPS; ++t) tips[t].filter(pose.fingertips_mm[t], dt_s, euro);
-    palm_center.filter(pose.palm_center_mm, dt_s, euro);
-    palm_normal.filter(pose.palm_normal, dt_s, euro);
-    const float n = std::sqrt(pose.palm_normal[0] * pose.palm_normal[0] + pose.palm_normal[1] * pose.palm_normal[1] +
-                              pose.palm_normal[2] * pose.palm_normal[2]);
+    if (hand.state != HANDTRACK_STATE_TRACKING) return;
+    for (int j = 0; j < HANDTRACK_NUM_JOINTS; ++j) joints[j].filter(hand.joints_mm[j], dt_s, euro);
+    for (int t = 0; t < HANDTRACK_NUM_FINGERTIPS; ++t) tips[t].filter(hand.fingertips_mm[t], dt_s, euro);
+    palm_center.filter(hand.palm_center_mm, dt_s, euro);
+    palm_normal.filter(hand.palm_normal, dt_s, euro);
+    const float n = std::sqrt(hand.palm_normal[0] * hand.palm_normal[0] + hand.palm_normal[1] * hand.palm_normal[1] +
+                              hand.palm_normal[2] * hand.palm_normal[2]);
     if (n > 0.0F) {
-      for (float& c : pose.palm_normal) c /= n;
+      for (float& c : hand.palm_normal) c /= n;
     }
     primed = true;
-    epoch = pose.epoch;
-    last_capture_ns = pose.capture_ns;
+    epoch = frame_epoch;
+    last_capture_ns = capture_ns;
+  }
+};
+
+}  // namespace
+
+// One HandFilter per hand a frame can hold, matched to the frame's hands by hand_id.
+struct handtrack_filter {
+  handtrack_filter_params params{};
+  OneEuroParams euro{};
+  std::array<HandFilter, HANDTRACK_MAX_HANDS> hands;
+
+  void reset() noexcept {
+    for (HandFilter& h : hands) {
+      h.reset();
+      h.hand_id = 0;
+    }
+  }
+
+  void apply(handtrack_frame& frame) noexcept {
+    const uint32_t count = std::min<uint32_t>(frame.hand_count, HANDTRACK_MAX_HANDS);
+    const auto in_frame = [&](uint32_t id) {
+      for (uint32_t i = 0; i < count; ++i) {
+        if (frame.hands[i].hand_id == id) return true;
+      }
+      return false;
+    };
+    // A hand missing from this frame has left: its history goes (a returning hand gets a new id).
+    for (HandFilter& h : hands) {
+      if (h.hand_id != 0 && !in_frame(h.hand_id)) h.hand_id = 0;
+    }
+    for (uint32_t i = 0; i < count; ++i) {
+      handtrack_hand& hand = frame.hands[i];
+      if (hand.hand_id == 0) continue;  // not a hand (a present hand never has id 0)
+      HandFilter* mine = nullptr;
+      for (HandFilter& h : hands) {
+        if (h.hand_id == hand.hand_id) mine = &h;
+      }
+      if (mine == nullptr) {  // a new hand: a free filter, started afresh
+        for (HandFilter& h : hands) {
+          if (h.hand_id == 0 && mine == nullptr) mine = &h;
+        }
+        mine->hand_id = hand.hand_id;
+        mine->reset();
+      }
+      mine->apply(hand, frame.epoch, frame.capture_ns, params, euro);
+    }
   }
 };
 
@@ -92,9 +146,9 @@ void handtrack_filter_reset(handtrack_filter* filter) {
   if (filter != nullptr) filter->reset();
 }
 
-int handtrack_filter_apply(handtrack_filter* filter, handtrack_pose* pose) {
-  if (filter == nullptr || pose == nullptr) return HANDTRACK_ERR_INVALID_ARGUMENT;
-  filter->apply(*pose);
+int handtrack_filter_apply(handtrack_filter* filter, handtrack_frame* frame) {
+  if (filter == nullptr || frame == nullptr) return HANDTRACK_ERR_INVALID_ARGUMENT;
+  filter->apply(*frame);
   return HANDTRACK_OK;
 }
 

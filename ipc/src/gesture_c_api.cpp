@@ -1,5 +1,5 @@
-// Gestures of the C API (handtrack/client.h, handtrack_gesture*): strengths from a pose's joints,
-// and start/end events with hysteresis (docs/GESTURES.md).
+// Gestures of the C API (handtrack/client.h, handtrack_gesture*): strengths from a hand's joints,
+// and start/end events with hysteresis, for each hand of a frame by its hand_id (docs/GESTURES.md).
 #include <handtrack/client.h>
 
 #include <algorithm>
@@ -11,7 +11,7 @@ namespace {
 // Joints (SPEC.md): 0 the wrist, then per finger (thumb..little) base, PIP, DIP, tip.
 constexpr int kIndex = 1;
 constexpr int kLittle = 4;
-const float* joint(const handtrack_pose& p, int finger, int k) { return p.joints_mm[1 + 4 * finger + k]; }
+const float* joint(const handtrack_hand& p, int finger, int k) { return p.joints_mm[1 + 4 * finger + k]; }
 
 float distance(const float* a, const float* b) {
   const float dx = a[0] - b[0];
@@ -27,7 +27,7 @@ float unit(float x) { return std::isfinite(x) ? std::clamp(x, 0.0F, 1.0F) : 0.0F
 // finger reaches about 0.45 of it (the synthetic fists: 0.40-0.50).
 constexpr float kStraightReach = 0.95F;
 constexpr float kCurledReach = 0.50F;
-float curl(const handtrack_pose& p, int finger) {
+float curl(const handtrack_hand& p, int finger) {
   const float length = distance(joint(p, finger, 0), joint(p, finger, 1)) +
                        distance(joint(p, finger, 1), joint(p, finger, 2)) +
                        distance(joint(p, finger, 2), joint(p, finger, 3));
@@ -41,24 +41,53 @@ float curl(const handtrack_pose& p, int finger) {
 constexpr float kPinchClosedMm = 20.0F;
 constexpr float kPinchOpenMm = 60.0F;
 
+// The hysteresis of one hand.
+struct HandGestures {
+  uint32_t hand_id = 0;  // 0: free
+  int32_t handedness = HANDTRACK_HANDEDNESS_UNKNOWN;
+  bool active[HANDTRACK_NUM_GESTURES] = {};
+};
+
+// Hysteresis: on above HANDTRACK_GESTURE_ON, off below HANDTRACK_GESTURE_OFF or without a hand;
+// in between nothing changes, so jitter around one threshold makes no burst of events.
+void step(HandGestures& h, bool hand, handtrack_gesture_state& out) {
+  out.hand_id = h.hand_id;
+  out.handedness = h.handedness;
+  out.present = hand ? 1 : 0;
+  for (int g = 0; g < HANDTRACK_NUM_GESTURES; ++g) {
+    bool& on = h.active[g];
+    const bool was = on;
+    if (!hand) {
+      on = false;
+    } else if (!on && out.strength[g] > HANDTRACK_GESTURE_ON) {
+      on = true;
+    } else if (on && out.strength[g] < HANDTRACK_GESTURE_OFF) {
+      on = false;
+    }
+    out.active[g] = on ? 1 : 0;
+    out.event[g] = on == was ? HANDTRACK_GESTURE_NONE : (on ? HANDTRACK_GESTURE_START : HANDTRACK_GESTURE_END);
+  }
+}
+
 }  // namespace
 
+// The hands of the last update, matched to the next frame's hands by hand_id.
 struct handtrack_gestures {
-  bool active[HANDTRACK_NUM_GESTURES] = {};
+  HandGestures hands[HANDTRACK_MAX_HANDS];
 };
 
 extern "C" {
 
-void handtrack_gesture_strengths(const handtrack_pose* pose, float out[HANDTRACK_NUM_GESTURES]) {
+void handtrack_gesture_strengths(const handtrack_hand* hand, float out[HANDTRACK_NUM_GESTURES]) {
   if (out == nullptr) return;
   std::fill(out, out + HANDTRACK_NUM_GESTURES, 0.0F);
-  if (pose == nullptr || pose->state == HANDTRACK_STATE_NO_HAND) return;
-  const float pinch = distance(pose->fingertips_mm[0], pose->fingertips_mm[1]);
+  if (hand == nullptr || hand->state == HANDTRACK_STATE_NO_HAND) return;
+  const float pinch = distance(hand->fingertips_mm[0], hand->fingertips_mm[1]);
   out[HANDTRACK_GESTURE_PINCH] = unit((kPinchOpenMm - pinch) / (kPinchOpenMm - kPinchClosedMm));
   float others = 0.0F;  // middle..little
-  for (int f = kIndex + 1; f <= kLittle; ++f) others += curl(*pose, f);
+  for (int f = kIndex + 1; f <= kLittle; ++f) others += curl(*hand, f);
   others /= 3.0F;
-  const float index = curl(*pose, kIndex);
+  const float index = curl(*hand, kIndex);
   out[HANDTRACK_GESTURE_GRAB] = unit(0.25F * index + 0.75F * others);
   out[HANDTRACK_GESTURE_POINT] = unit(std::min(1.0F - index, others));
 }
@@ -75,26 +104,46 @@ void handtrack_gestures_reset(handtrack_gestures* gestures) {
   if (gestures != nullptr) *gestures = handtrack_gestures{};
 }
 
-int handtrack_gestures_update(handtrack_gestures* gestures, const handtrack_pose* pose, handtrack_gesture_state* out) {
-  if (gestures == nullptr || pose == nullptr || out == nullptr) return HANDTRACK_ERR_INVALID_ARGUMENT;
-  handtrack_gesture_strengths(pose, out->strength);
-  const bool hand = pose->state != HANDTRACK_STATE_NO_HAND;
-  for (int g = 0; g < HANDTRACK_NUM_GESTURES; ++g) {
-    bool& on = gestures->active[g];
-    const bool was = on;
-    // Hysteresis: on above HANDTRACK_GESTURE_ON, off below HANDTRACK_GESTURE_OFF or without a
-    // hand; in between nothing changes, so jitter around one threshold makes no burst of events.
-    if (!hand) {
-      on = false;
-    } else if (!on && out->strength[g] > HANDTRACK_GESTURE_ON) {
-      on = true;
-    } else if (on && out->strength[g] < HANDTRACK_GESTURE_OFF) {
-      on = false;
-    }
-    out->active[g] = on ? 1 : 0;
-    out->event[g] = on == was ? HANDTRACK_GESTURE_NONE : (on ? HANDTRACK_GESTURE_START : HANDTRACK_GESTURE_END);
+int handtrack_gestures_update(handtrack_gestures* gestures, const handtrack_frame* frame,
+                              handtrack_gesture_state out[HANDTRACK_GESTURE_MAX_STATES]) {
+  if (gestures == nullptr || frame == nullptr || out == nullptr) return HANDTRACK_ERR_INVALID_ARGUMENT;
+  const uint32_t count = std::min<uint32_t>(frame->hand_count, HANDTRACK_MAX_HANDS);
+  int n = 0;
+  // The hands that left first (their slots are then free for new hands), reported after the
+  // frame's own hands.
+  handtrack_gesture_state left[HANDTRACK_MAX_HANDS];
+  int n_left = 0;
+  for (HandGestures& h : gestures->hands) {
+    if (h.hand_id == 0) continue;
+    bool there = false;
+    for (uint32_t i = 0; i < count; ++i) there = there || frame->hands[i].hand_id == h.hand_id;
+    if (there) continue;
+    handtrack_gesture_state& s = left[n_left++];
+    std::fill(s.strength, s.strength + HANDTRACK_NUM_GESTURES, 0.0F);
+    step(h, false, s);
+    h = HandGestures{};
   }
-  return HANDTRACK_OK;
+  for (uint32_t i = 0; i < count; ++i) {
+    const handtrack_hand& hand = frame->hands[i];
+    if (hand.hand_id == 0) continue;  // not a hand (a present hand never has id 0)
+    HandGestures* mine = nullptr;
+    for (HandGestures& h : gestures->hands) {
+      if (h.hand_id == hand.hand_id) mine = &h;
+    }
+    if (mine == nullptr) {  // a new hand: a free slot, nothing on yet
+      for (HandGestures& h : gestures->hands) {
+        if (h.hand_id == 0 && mine == nullptr) mine = &h;
+      }
+      *mine = HandGestures{};
+      mine->hand_id = hand.hand_id;
+    }
+    mine->handedness = hand.handedness;
+    handtrack_gesture_state& s = out[n++];
+    handtrack_gesture_strengths(&hand, s.strength);
+    step(*mine, hand.state != HANDTRACK_STATE_NO_HAND, s);
+  }
+  for (int k = 0; k < n_left; ++k) out[n++] = left[k];
+  return n;
 }
 
 const char* handtrack_gesture_name(int gesture) {

@@ -23,7 +23,7 @@ struct PoseRingReader::Mapping {
 namespace {
 
 // Bounded retries when the writer laps a slot during our copy (needs `capacity` publishes during
-// one 640-byte copy, so in practice never more than one retry).
+// one 1336-byte copy, so in practice never more than one retry).
 constexpr int kReadAttempts = 16;
 // open() retries while the writer is between shm_open and publishing the magic (microseconds).
 constexpr int kNotReadyAttempts = 20;
@@ -157,17 +157,20 @@ void PoseRingReader::accept(std::uint64_t index) noexcept {
   last_index_ = index;
 }
 
-Status PoseRingReader::read_index(std::uint64_t index, PoseRecord& out) noexcept {
+Status PoseRingReader::read_index(std::uint64_t index, FrameRecord& out) noexcept {
   const shm::Slot& slot = slots_[index % capacity_];
   switch (detail::seqlock_read(slot.seq, slot.words, &out, shm::kRecordWords, 2 * index + 2)) {
-    case detail::SeqRead::kOk: return HANDTRACK_OK;
+    case detail::SeqRead::kOk:
+      // Callers loop over hands[0 .. hand_count-1]: a corrupt count must not take them past the end.
+      out.hand_count = std::min(out.hand_count, kMaxHands);
+      return HANDTRACK_OK;
     case detail::SeqRead::kNotYet: return HANDTRACK_TIMEOUT;
     case detail::SeqRead::kGone: break;
   }
   return HANDTRACK_ERR_BUSY;
 }
 
-Status PoseRingReader::latest(PoseRecord& out) noexcept {
+Status PoseRingReader::latest(FrameRecord& out) noexcept {
   if (header_ == nullptr) return HANDTRACK_ERR_INVALID_ARGUMENT;
   // SYNC: relaxed: a hint to re-open the name; the new segment is validated with acquire.
   if (header_->superseded.load(std::memory_order_relaxed) != 0) try_reattach();
@@ -184,7 +187,7 @@ Status PoseRingReader::latest(PoseRecord& out) noexcept {
   return HANDTRACK_ERR_BUSY;
 }
 
-Status PoseRingReader::try_next(PoseRecord& out) noexcept {
+Status PoseRingReader::try_next(FrameRecord& out) noexcept {
   if (header_ == nullptr) return HANDTRACK_ERR_INVALID_ARGUMENT;
   const std::uint64_t wanted = next_index_;
   std::uint64_t index = wanted;
@@ -231,7 +234,7 @@ bool PoseRingReader::try_reattach() noexcept {
   }
 }
 
-Status PoseRingReader::wait(PoseRecord& out, std::chrono::nanoseconds timeout,
+Status PoseRingReader::wait(FrameRecord& out, std::chrono::nanoseconds timeout,
                             Mode mode) noexcept {
   if (header_ == nullptr) return HANDTRACK_ERR_INVALID_ARGUMENT;
   const std::int64_t start = detail::monotonic_ns();
@@ -293,11 +296,11 @@ Status PoseRingReader::wait(PoseRecord& out, std::chrono::nanoseconds timeout,
   }
 }
 
-Status PoseRingReader::wait_next(PoseRecord& out, std::chrono::nanoseconds timeout) noexcept {
+Status PoseRingReader::wait_next(FrameRecord& out, std::chrono::nanoseconds timeout) noexcept {
   return wait(out, timeout, Mode::kNext);
 }
 
-Status PoseRingReader::wait_latest(PoseRecord& out, std::chrono::nanoseconds timeout) noexcept {
+Status PoseRingReader::wait_latest(FrameRecord& out, std::chrono::nanoseconds timeout) noexcept {
   return wait(out, timeout, Mode::kLatest);
 }
 

@@ -60,14 +60,18 @@ Status validate_segment(const void* base, std::size_t mapped_size, std::string* 
                 kEndianMarker);
   }
   if (h->abi_version != kAbiVersion) {
+    // Say which side to update: the one with the older version.
     return fail(detail, HANDTRACK_ERR_BAD_VERSION,
-                "segment ABI version is %" PRIu32 ", this client reads version %" PRIu32,
-                h->abi_version, kAbiVersion);
+                "segment has ABI version %" PRIu32 ", this client reads version %" PRIu32 ": %s",
+                h->abi_version, kAbiVersion,
+                h->abi_version > kAbiVersion
+                    ? "rebuild the client against the installed handtrack"
+                    : "the running handtrackd is older than this client; upgrade and restart it");
   }
-  if (h->record_size != sizeof(PoseRecord)) {
+  if (h->record_size != sizeof(FrameRecord)) {
     return fail(detail, HANDTRACK_ERR_BAD_RECORD_SIZE,
                 "segment record size is %" PRIu32 " bytes, this client expects %zu",
-                h->record_size, sizeof(PoseRecord));
+                h->record_size, sizeof(FrameRecord));
   }
   if (h->header_size != sizeof(Header)) {
     return fail(detail, HANDTRACK_ERR_BAD_LAYOUT, "header size is %" PRIu32 ", expected %zu",

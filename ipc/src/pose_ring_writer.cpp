@@ -183,7 +183,7 @@ PoseRingWriter::PoseRingWriter(const Options& options)
   header_->abi_version = kAbiVersion;
   header_->endian_marker = shm::kEndianMarker;
   header_->header_size = sizeof(shm::Header);
-  header_->record_size = sizeof(PoseRecord);
+  header_->record_size = sizeof(FrameRecord);
   header_->slot_size = sizeof(shm::Slot);
   header_->capacity = capacity_;
   header_->total_size = total;
@@ -213,11 +213,11 @@ PoseRingWriter::~PoseRingWriter() {
   if (header_ != nullptr) mark_stopped();
 }
 
-void PoseRingWriter::publish(const PoseRecord& pose) noexcept {
+void PoseRingWriter::publish(const FrameRecord& frame) noexcept {
   const std::uint64_t index = next_index_;
   shm::Slot& slot = slots_[index % capacity_];
   const std::int64_t now = detail::monotonic_ns();
-  PoseRecord stamped = pose;
+  FrameRecord stamped = frame;
   stamped.epoch = epoch_;
   stamped.publish_ns = now;
 

@@ -49,15 +49,18 @@ def smoothed(frames, params):
     pose_filter = handtrack.PoseFilter(**params)
     out = []
     for fr in frames:
-        pose = handtrack.Pose()
-        pose.epoch = 1
-        pose.capture_ns = int(round(fr["time_s"] * 1e9)) + 1_000_000_000
-        pose.state = fr["state"]
+        frame = handtrack.Frame()  # one hand, always the same id: the sequence is one hand's
+        frame.epoch = 1
+        frame.capture_ns = int(round(fr["time_s"] * 1e9)) + 1_000_000_000
+        frame.hand_count = 1
+        hand = frame.hand_records[0]
+        hand.hand_id = 1
+        hand.state = fr["state"]
         for t in range(TIPS):
             for k in range(3):
-                pose.fingertips_mm[t][k] = fr["est"][t][k]
-        pose_filter.apply(pose)
-        out.append([[pose.fingertips_mm[t][k] for k in range(3)] for t in range(TIPS)])
+                hand.fingertips_mm[t][k] = fr["est"][t][k]
+        pose_filter.apply(frame)
+        out.append([[hand.fingertips_mm[t][k] for k in range(3)] for t in range(TIPS)])
     return out
 
 

@@ -36,6 +36,13 @@ struct Event {
   int kind;  // HANDTRACK_GESTURE_START or _END
 };
 
+// The events of `gesture` in one update of `gestures` with `frame`, for every hand.
+void collect(handtrack::Gestures& gestures, const handtrack_frame& frame, int gesture, int i, std::vector<Event>& out) {
+  for (const handtrack_gesture_state& g : gestures.update(frame)) {
+    if (g.event[gesture] != HANDTRACK_GESTURE_NONE) out.push_back({i, g.event[gesture]});
+  }
+}
+
 // Events of `gesture` from tracked poses and from the ground truth of `motion`.
 std::pair<std::vector<Event>, std::vector<Event>> events_of(const std::string& motion, int gesture, int frames) {
   synth::SyntheticCamera camera(synth::live_camera_options(motion, kFrames, 1, 60));
@@ -48,18 +55,24 @@ std::pair<std::vector<Event>, std::vector<Event>> events_of(const std::string& m
   for (int i = 0; i < frames; ++i) {
     camera.render(i, frame);
     const TrackerOutput out = tracker.track(frame.depth);
-    handtrack_pose pose{};
-    pose.state = static_cast<int32_t>(out.state);
-    copy_points(out.joints, pose.joints_mm, HANDTRACK_NUM_JOINTS);
-    copy_points(out.fingertips, pose.fingertips_mm, HANDTRACK_NUM_FINGERTIPS);
-    if (const int e = tracked.update(pose).event[gesture]; e != HANDTRACK_GESTURE_NONE) from_tracker.push_back({i, e});
-    handtrack_pose real{};
-    real.state = HANDTRACK_STATE_TRACKING;
-    copy_points(frame.joints, real.joints_mm, HANDTRACK_NUM_JOINTS);
+    handtrack_frame seen{};  // as the daemon publishes it: no hand seen, no hands
+    if (out.state != TrackingState::kNoHand) {
+      handtrack_hand& hand = seen.hands[seen.hand_count++];
+      hand.hand_id = out.hand_id;
+      hand.state = out.state == TrackingState::kTracking ? HANDTRACK_STATE_TRACKING : HANDTRACK_STATE_RECOVERING;
+      copy_points(out.joints, hand.joints_mm, HANDTRACK_NUM_JOINTS);
+      copy_points(out.fingertips, hand.fingertips_mm, HANDTRACK_NUM_FINGERTIPS);
+    }
+    collect(tracked, seen, gesture, i, from_tracker);
+    handtrack_frame real{};
+    real.hand_count = 1;
+    real.hands[0].hand_id = 1;
+    real.hands[0].state = HANDTRACK_STATE_TRACKING;
+    copy_points(frame.joints, real.hands[0].joints_mm, HANDTRACK_NUM_JOINTS);
     std::array<Eigen::Vector3d, 5> tips;
     for (size_t t = 0; t < 5; ++t) tips[t] = *frame.fingertips[t];
-    copy_points(tips, real.fingertips_mm, HANDTRACK_NUM_FINGERTIPS);
-    if (const int e = truth.update(real).event[gesture]; e != HANDTRACK_GESTURE_NONE) from_truth.push_back({i, e});
+    copy_points(tips, real.hands[0].fingertips_mm, HANDTRACK_NUM_FINGERTIPS);
+    collect(truth, real, gesture, i, from_truth);
   }
   return {from_tracker, from_truth};
 }
@@ -103,7 +116,7 @@ TEST(GestureMotions, PointingOfFingercountInTheGroundTruth) {
     EXPECT_EQ(truth[i].kind, i % 2 == 0 ? HANDTRACK_GESTURE_START : HANDTRACK_GESTURE_END) << describe(truth);
     if (truth[i].kind != HANDTRACK_GESTURE_START) continue;
     const synth::SynthFrame f = camera.render(truth[i].frame);
-    handtrack_pose real{};
+    handtrack_hand real{};
     real.state = HANDTRACK_STATE_TRACKING;
     copy_points(f.joints, real.joints_mm, HANDTRACK_NUM_JOINTS);
     float strength[HANDTRACK_NUM_GESTURES];

@@ -103,27 +103,38 @@ class WsClient {
   beast::error_code error_;
 };
 
-TEST_F(WsBridge, SendsPosesWithTheSpecFields) {
+TEST_F(WsBridge, SendsFramesWithTheSpecFields) {
   WsClient client(bridge->origin());
   ASSERT_FALSE(client.error()) << client.error().message() << "\n" << bridge->logs();
   uint64_t last_frame = 0;
+  int hands_seen = 0;
   for (int i = 0; i < 20; ++i) {
-    const json pose = client.read();
-    for (const char* field : {"frame", "epoch", "state", "capture_ns", "publish_ns", "confidence", "energy", "params",
-                              "joints", "fingertips", "pinch", "missed"}) {
-      ASSERT_TRUE(pose.contains(field)) << field << " missing in " << pose.dump();
+    const json message = client.read();
+    for (const char* field : {"frame", "epoch", "capture_ns", "publish_ns", "hands", "missed"}) {
+      ASSERT_TRUE(message.contains(field)) << field << " missing in " << message.dump();
     }
-    EXPECT_EQ(pose["params"].size(), 26U);
-    ASSERT_EQ(pose["joints"].size(), 21U);
-    EXPECT_EQ(pose["joints"][20].size(), 3U);
-    EXPECT_EQ(pose["fingertips"].size(), 5U);
-    EXPECT_TRUE(pose["pinch"].contains("distance_mm") && pose["pinch"].contains("strength"));
-    const auto frame = pose["frame"].get<uint64_t>();
+    ASSERT_TRUE(message["hands"].is_array());
+    for (const json& hand : message["hands"]) {
+      for (const char* field : {"hand_id", "handedness", "handedness_confidence", "state", "confidence", "energy",
+                                "params", "joints", "fingertips", "pinch"}) {
+        ASSERT_TRUE(hand.contains(field)) << field << " missing in " << hand.dump();
+      }
+      EXPECT_GT(hand["hand_id"].get<uint32_t>(), 0U);
+      EXPECT_TRUE(hand["handedness"] == "left" || hand["handedness"] == "right") << hand["handedness"];
+      EXPECT_EQ(hand["params"].size(), 26U);
+      ASSERT_EQ(hand["joints"].size(), 21U);
+      EXPECT_EQ(hand["joints"][20].size(), 3U);
+      EXPECT_EQ(hand["fingertips"].size(), 5U);
+      EXPECT_TRUE(hand["pinch"].contains("distance_mm") && hand["pinch"].contains("strength"));
+      ++hands_seen;
+    }
+    const auto frame = message["frame"].get<uint64_t>();
     if (i > 0) {
-      EXPECT_GT(frame, last_frame) << "poses in order";
+      EXPECT_GT(frame, last_frame) << "frames in order";
     }
     last_frame = frame;
   }
+  EXPECT_GT(hands_seen, 0) << "the synthetic camera shows a hand";
 }
 
 // The HTTP status of a WebSocket upgrade request to /poses from `origin`.

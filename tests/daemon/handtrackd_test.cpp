@@ -46,18 +46,22 @@ Run run(const std::vector<std::string>& argv, const TempDir& dir, const std::str
   return {code.value_or(-1), child.out(), child.err()};
 }
 
-// Mean fingertip error (mm) of the cat's JSON lines against `truth(frame)`.
+// Mean fingertip error (mm) of the cat's JSON lines (one hand each) against `truth(frame)`. A
+// frame without a hand is a miss and fails the test.
 template <typename Truth>
 double mean_fingertip_error(const std::vector<json>& poses, Truth truth) {
   double sum = 0.0;
   int frames = 0;
   for (const auto& p : poses) {
     const Fingertips tips = truth(p.at("frame").get<int>());
+    const json& hands = p.at("hands");
+    EXPECT_EQ(hands.size(), 1U) << "frame " << p.at("frame") << ": the hand is missed";
+    if (hands.empty()) continue;
     double frame_sum = 0.0;
     int n = 0;
     for (int f = 0; f < kNumFingers; ++f) {
       if (!tips[static_cast<size_t>(f)]) continue;
-      const auto& t = p.at("fingertips").at(static_cast<size_t>(f));
+      const auto& t = hands[0].at("fingertips").at(static_cast<size_t>(f));
       const Eigen::Vector3d got(t.at(0).get<double>(), t.at(1).get<double>(), t.at(2).get<double>());
       frame_sum += (got - *tips[static_cast<size_t>(f)]).norm();
       ++n;
@@ -156,11 +160,14 @@ TEST_F(Handtrackd, SeqSourceFingertipsMatchGroundTruth) {
   std::printf("seq: mean fingertip error over %zu poses: %.1f mm\n", poses.size(), error);
   EXPECT_LT(error, kMaxMeanFingertipErrorMm);
   for (const auto& p : poses) {
-    EXPECT_EQ(p.at("params").size(), 26U);
-    EXPECT_EQ(p.at("joints").size(), 21U);
+    for (const json& hand : p.at("hands")) {
+      EXPECT_EQ(hand.at("params").size(), 26U);
+      EXPECT_EQ(hand.at("joints").size(), 21U);
+    }
     EXPECT_GT(p.at("publish_ns").get<int64_t>(), p.at("capture_ns").get<int64_t>());
   }
-  EXPECT_EQ(poses.back().at("state"), "tracking");
+  ASSERT_EQ(poses.back().at("hands").size(), 1U);
+  EXPECT_EQ(poses.back().at("hands")[0].at("state"), "tracking");
   // The daemon exited at the end of the recording: the ring says so.
   EXPECT_EQ(cat_status(shm.str(), dir_).value("device_state", ""), "stopped");
 }
@@ -179,10 +186,47 @@ TEST_F(Handtrackd, SyntheticSourceFingertipsMatchGroundTruth) {
   const double error = mean_fingertip_error(poses, [&](int frame) { return camera.render(frame).fingertips; });
   std::printf("synthetic: mean fingertip error over %zu poses: %.1f mm\n", poses.size(), error);
   EXPECT_LT(error, kMaxMeanFingertipErrorMm);
-  const auto& last = poses.back();
+  ASSERT_EQ(poses.back().at("hands").size(), 1U);
+  const json& last = poses.back().at("hands")[0];
   EXPECT_GE(last.at("pinch").at("strength").get<double>(), 0.0);
   EXPECT_GT(last.at("confidence").get<double>(), 0.0);
   EXPECT_NEAR(last.at("hand_scale").at("length").get<double>(), 1.0, 1e-6);
+}
+
+// ABI version 2 end to end: handtrack-cat prints one object per frame with its hands, each with its
+// id and handedness; the synthetic camera renders a right hand, and it keeps its id while in view.
+TEST_F(Handtrackd, CatPrintsEachFramesHandsWithIdAndHandedness) {
+  ShmName shm("hands");
+  Child cat({kCat, "--shm-name", shm.str(), "--count", "30", "--timeout", "30", "--from-start"}, dir_ / "cat.out",
+            dir_ / "cat.err");
+  const auto r = run(daemon_args({"--source", "synthetic:pinch", "--fast", "--frames", "40", "--shm-name", shm.str()}),
+                     dir_, "daemon", 60s);
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_EQ(cat.wait(30s), 0) << cat.err();
+  const std::string text = cat.out();
+  EXPECT_NE(text.find("\"hands\":[{\"hand_id\":"), std::string::npos) << text.substr(0, 400);
+  const auto frames = parse_lines(text);
+  ASSERT_EQ(frames.size(), 30U);
+  std::uint32_t id = 0;
+  int right = 0;
+  for (const auto& f : frames) {
+    for (const char* field : {"frame", "epoch", "capture_ns", "publish_ns", "missed", "hands"}) {
+      EXPECT_TRUE(f.contains(field)) << field << " missing in " << f.dump();
+    }
+    ASSERT_EQ(f.at("hands").size(), 1U) << "one hand in view: " << f.dump();
+    const json& hand = f.at("hands")[0];
+    const auto hand_id = hand.at("hand_id").get<std::uint32_t>();
+    EXPECT_NE(hand_id, 0U);
+    if (id != 0) {
+      EXPECT_EQ(hand_id, id) << "the hand keeps its id while it stays in view";
+    }
+    id = hand_id;
+    right += hand.at("handedness") == "right";
+    const auto confidence = hand.at("handedness_confidence").get<double>();
+    EXPECT_TRUE(confidence >= 0.0 && confidence <= 1.0) << confidence;
+  }
+  EXPECT_EQ(frames.back().at("hands")[0].at("handedness"), "right") << "the synthetic camera renders a right hand";
+  EXPECT_GE(right, 27) << "of 30 frames seen as a right hand";
 }
 
 // ---- sd_notify -------------------------------------------------------------------------------
@@ -471,7 +515,7 @@ TEST_F(Handtrackd, AllZeroAndAllMaxRangeFramesAreNoHand) {
   EXPECT_EQ(s.empty, s.published) << "every published frame without depth counts as empty\n" << r.err;
   EXPECT_EQ(s.published + s.dropped, kFrames) << r.err;
   ASSERT_EQ(cat.wait(20s), 0) << cat.err();
-  for (const auto& p : parse_lines(cat.out())) EXPECT_EQ(p.at("state"), "no_hand");
+  for (const auto& p : parse_lines(cat.out())) EXPECT_TRUE(p.at("hands").empty()) << p.dump();
 }
 
 // The real OpenNI2 recording (head and shoulders at ~1.5 m, a shoulder reaching to ~550 mm, no
@@ -490,7 +534,7 @@ TEST_F(Handtrackd, RealOniRecordingWithoutAHandIsNoHand) {
   ASSERT_EQ(cat.wait(20s), 0) << cat.err();
   const auto poses = parse_lines(cat.out());
   EXPECT_EQ(poses.size(), 10U);
-  for (const auto& p : poses) EXPECT_EQ(p.at("state"), "no_hand");
+  for (const auto& p : poses) EXPECT_TRUE(p.at("hands").empty()) << p.dump();
 }
 
 struct BadConfig {

@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <functional>
+#include <limits>
 #include <thread>
 
 namespace handtrack::daemon {
@@ -65,7 +66,7 @@ struct Ring {
 };
 
 struct RunResult {
-  std::vector<ipc::PoseRecord> records;  // every pose published, read through a real ring
+  std::vector<ipc::FrameRecord> records;  // every frame published, read through a real ring
   PipelineCounters counters;
 };
 
@@ -79,7 +80,7 @@ RunResult run_to_end(const DaemonConfig& config, std::unique_ptr<DepthSource> so
   EXPECT_TRUE(pipeline.start(&why)) << why;
   RunResult out;
   const auto deadline = std::chrono::steady_clock::now() + 60s;
-  ipc::PoseRecord r{};
+  ipc::FrameRecord r{};
   while (!pipeline.finished() && std::chrono::steady_clock::now() < deadline) {
     while (reader.wait_next(r, 20ms) == HANDTRACK_OK) out.records.push_back(r);
   }
@@ -91,10 +92,13 @@ RunResult run_to_end(const DaemonConfig& config, std::unique_ptr<DepthSource> so
   return out;
 }
 
-double fingertip_error_mm(const ipc::PoseRecord& r, const Fingertips& truth) {
+// The error of the frame's one hand (a frame without a hand is a miss: infinite).
+double fingertip_error_mm(const ipc::FrameRecord& r, const Fingertips& truth) {
+  if (r.hand_count != 1) return std::numeric_limits<double>::infinity();
+  const ipc::HandRecord& hand = r.hands[0];
   double sum = 0.0;
   for (int f = 0; f < kNumFingers; ++f) {
-    const Eigen::Vector3d got(r.fingertips_mm[f][0], r.fingertips_mm[f][1], r.fingertips_mm[f][2]);
+    const Eigen::Vector3d got(hand.fingertips_mm[f][0], hand.fingertips_mm[f][1], hand.fingertips_mm[f][2]);
     sum += (got - *truth[static_cast<size_t>(f)]).norm();
   }
   return sum / kNumFingers;
@@ -121,6 +125,7 @@ TEST(Pipeline, ResolutionChangeMidStreamRebuildsBuffersAndKeepsTracking) {
   double error = 0.0;
   for (uint64_t i = kFrames - 20; i < kFrames; ++i) {
     EXPECT_EQ(records[i].frame, i);
+    EXPECT_NE(records[i].hands[0].hand_id, 0U) << "a present hand has an id";
     error += fingertip_error_mm(records[i], big.render(static_cast<int>(i)).fingertips) / 20.0;
   }
   EXPECT_LT(error, 40.0);
@@ -140,8 +145,8 @@ TEST(Pipeline, FramesWithoutDepthInTheWorkingVolumeAreNoHandAndCounted) {
   EXPECT_EQ(c.frames_empty, kFrames);
   ASSERT_EQ(records.size(), kFrames);
   for (const auto& r : records) {
-    EXPECT_EQ(r.state, HANDTRACK_STATE_NO_HAND);
-    EXPECT_EQ(r.confidence, 0.0F);
+    EXPECT_EQ(r.hand_count, 0U) << "no hand seen: a frame with no hands";
+    EXPECT_EQ(r.hands[0].hand_id, 0U);
   }
 }
 

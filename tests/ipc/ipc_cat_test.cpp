@@ -48,7 +48,7 @@ int count_lines(const std::string& s) {
 
 }  // namespace
 
-TEST(HandtrackCat, PrintsOneJsonObjectPerPoseWithTheSpecFields) {
+TEST(HandtrackCat, PrintsOneJsonObjectPerFrameWithItsHandsAndTheSpecFields) {
   const std::string name = "ht_cat_" + std::to_string(::getpid());
   handtrack::ipc::PoseRingWriter::remove(name);
   const pid_t writer = ::fork();
@@ -71,25 +71,39 @@ TEST(HandtrackCat, PrintsOneJsonObjectPerPoseWithTheSpecFields) {
   for (std::string line; std::getline(lines, line);) {
     const auto j = nlohmann::json::parse(line);
     const std::uint64_t frame = j.at("frame").get<std::uint64_t>();
-    const handtrack::ipc::PoseRecord expected = handtrack::ipc::test::make_test_record(frame);
+    const handtrack::ipc::FrameRecord expected = handtrack::ipc::test::make_test_record(frame);
     EXPECT_GT(j.at("epoch").get<std::uint64_t>(), 0U);
-    const char* states[] = {"no_hand", "tracking", "recovering"};
-    EXPECT_EQ(j.at("state"), states[expected.state]);
     EXPECT_EQ(j.at("capture_ns").get<std::int64_t>(), expected.capture_ns);
     EXPECT_GT(j.at("publish_ns").get<std::int64_t>(), 0);
-    EXPECT_FLOAT_EQ(j.at("confidence").get<float>(), expected.confidence);
-    EXPECT_FLOAT_EQ(j.at("energy").get<float>(), expected.energy);
-    ASSERT_EQ(j.at("params").size(), 26U);
-    EXPECT_EQ(j.at("params")[3].get<double>(), expected.params[3]);
-    EXPECT_EQ(j.at("params")[25].get<double>(), expected.params[25]);  // exact round trip
-    ASSERT_EQ(j.at("joints").size(), 21U);
-    ASSERT_EQ(j.at("joints")[20].size(), 3U);
-    EXPECT_EQ(j.at("joints")[20][2].get<float>(), expected.joints_mm[20][2]);
-    ASSERT_EQ(j.at("fingertips").size(), 5U);
-    EXPECT_EQ(j.at("fingertips")[4][0].get<float>(), expected.fingertips_mm[4][0]);
-    EXPECT_EQ(j.at("pinch").at("distance_mm").get<float>(), expected.pinch_distance_mm);
-    EXPECT_EQ(j.at("pinch").at("strength").get<float>(), expected.pinch_strength);
-    EXPECT_EQ(j.at("hand_scale").at("width").get<float>(), 1.25F);
+    EXPECT_FLOAT_EQ(j.at("timings_ms").at("optimize").get<float>(), expected.optimize_ms);
+    const auto& hands = j.at("hands");
+    ASSERT_EQ(hands.size(), 2U) << "every hand of the frame, in one object";
+    const char* states[] = {"no_hand", "tracking", "recovering"};
+    for (std::size_t k = 0; k < hands.size(); ++k) {
+      SCOPED_TRACE("hand " + std::to_string(k));
+      const auto& h = hands[k];
+      const handtrack::ipc::HandRecord& e = expected.hands[k];
+      EXPECT_EQ(h.at("hand_id").get<std::uint32_t>(), e.hand_id);
+      EXPECT_EQ(h.at("handedness"), k == 0 ? "right" : "left");
+      EXPECT_FLOAT_EQ(h.at("handedness_confidence").get<float>(), e.handedness_confidence);
+      EXPECT_EQ(h.at("state"), states[e.state]);
+      EXPECT_FLOAT_EQ(h.at("confidence").get<float>(), e.confidence);
+      EXPECT_FLOAT_EQ(h.at("energy").get<float>(), e.energy);
+      EXPECT_FLOAT_EQ(h.at("optimize_ms").get<float>(), e.optimize_ms);
+      ASSERT_EQ(h.at("params").size(), 26U);
+      EXPECT_EQ(h.at("params")[0].get<double>(), static_cast<double>(frame)) << "the hand is of this frame";
+      EXPECT_EQ(h.at("params")[3].get<double>(), e.params[3]);
+      EXPECT_EQ(h.at("params")[25].get<double>(), e.params[25]);  // exact round trip
+      ASSERT_EQ(h.at("joints").size(), 21U);
+      ASSERT_EQ(h.at("joints")[20].size(), 3U);
+      EXPECT_EQ(h.at("joints")[20][2].get<float>(), e.joints_mm[20][2]);
+      ASSERT_EQ(h.at("fingertips").size(), 5U);
+      EXPECT_EQ(h.at("fingertips")[4][0].get<float>(), e.fingertips_mm[4][0]);
+      EXPECT_EQ(h.at("pinch").at("distance_mm").get<float>(), e.pinch_distance_mm);
+      EXPECT_EQ(h.at("pinch").at("strength").get<float>(), e.pinch_strength);
+      EXPECT_EQ(h.at("palm").at("normal")[2].get<float>(), e.palm_normal[2]);
+      EXPECT_EQ(h.at("hand_scale").at("width").get<float>(), e.hand_scale[1]);
+    }
     EXPECT_TRUE(j.at("missed").is_number_unsigned());
     if (!first) {
       EXPECT_EQ(frame, previous_frame + 1 + j.at("missed").get<std::uint64_t>());

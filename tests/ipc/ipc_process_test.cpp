@@ -31,7 +31,7 @@
 #include <unistd.h>
 
 using namespace std::chrono_literals;
-using handtrack::ipc::PoseRecord;
+using handtrack::ipc::FrameRecord;
 using handtrack::ipc::PoseRingReader;
 using handtrack::ipc::PoseRingWriter;
 
@@ -172,9 +172,10 @@ double percentile(std::vector<double> v, double p) {
 }  // namespace
 
 // A writer at full speed into a 2-slot ring (every publish overwrites the slot readers are most
-// likely copying) and several reader processes checking every accepted record: >= 10^6 reads,
-// zero torn records accepted.
-TEST(IpcProcess, TornRecordsAreNeverAcceptedAcrossProcesses) {
+// likely copying), each frame with two hands carrying its frame number, and several reader
+// processes checking every accepted frame: >= 10^6 reads, zero torn records accepted, and never a
+// frame whose hands belong to different frames (ABI v2: one seqlock covers every hand of a frame).
+TEST(IpcProcess, TornRecordsAndHandsOfTwoFramesAreNeverAcceptedAcrossProcesses) {
   ShmGuard shm(unique("torn"));
   Child writer(writer_cmd(shm.name, {"--capacity", "2", "--rate-hz", "0"}), temp_path("torn_w"));
   ASSERT_TRUE(writer.wait_for_line("ready", 5s));
@@ -193,6 +194,7 @@ TEST(IpcProcess, TornRecordsAreNeverAcceptedAcrossProcesses) {
     const auto s = summary_of(r->output());
     ASSERT_TRUE(s.count("reads")) << r->output();
     EXPECT_EQ(s.at("torn"), 0) << r->output();
+    EXPECT_EQ(s.at("mixed"), 0) << r->output();
     EXPECT_GT(s.at("distinct"), 10) << "the reader raced a progressing writer";
     total_reads += s.at("reads");
   }
@@ -202,8 +204,8 @@ TEST(IpcProcess, TornRecordsAreNeverAcceptedAcrossProcesses) {
 }
 
 // The negative control for the test above: the same race read WITHOUT the seqlock check does
-// produce torn records, so the checker can see them.
-TEST(IpcProcess, TheCheckerSeesTornRecordsWhenTheSeqlockIsBypassed) {
+// produce torn records and frames with hands of two frames, so the checker can see both.
+TEST(IpcProcess, TheCheckerSeesTornRecordsAndMixedHandsWhenTheSeqlockIsBypassed) {
   ShmGuard shm(unique("unchecked"));
   Child writer(writer_cmd(shm.name, {"--capacity", "2", "--rate-hz", "0"}), temp_path("unch_w"));
   ASSERT_TRUE(writer.wait_for_line("ready", 5s));
@@ -215,6 +217,7 @@ TEST(IpcProcess, TheCheckerSeesTornRecordsWhenTheSeqlockIsBypassed) {
   const auto s = summary_of(reader.output());
   ASSERT_TRUE(s.count("torn")) << reader.output();
   EXPECT_GT(s.at("torn"), 0) << "reads=" << s.at("reads");
+  EXPECT_GT(s.at("mixed"), 0) << "reads=" << s.at("reads") << " torn=" << s.at("torn");
 }
 
 // One reader SIGKILLed in the middle of reading, another SIGSTOPped for 5 s: the writer's
@@ -390,7 +393,7 @@ TEST(IpcProcess, GroupMembersReadOthersAreRefused) {
       PoseRingReader reader;
       const auto status = reader.open(shm.name);
       if (status != HANDTRACK_OK) ::_exit(status == HANDTRACK_ERR_PERMISSION ? 20 : 91);
-      PoseRecord record{};
+      FrameRecord record{};
       if (reader.latest(record) != HANDTRACK_OK || record.frame != 77) ::_exit(92);
       ::_exit(10);
     }

@@ -27,10 +27,11 @@
 namespace bip = boost::interprocess;
 using namespace std::chrono_literals;
 using handtrack::ipc::DeviceState;
-using handtrack::ipc::PoseRecord;
+using handtrack::ipc::FrameRecord;
 using handtrack::ipc::PoseRingReader;
 using handtrack::ipc::PoseRingWriter;
 using handtrack::ipc::Status;
+using handtrack::ipc::test::hands_of_one_frame;
 using handtrack::ipc::test::is_whole_test_record;
 using handtrack::ipc::test::make_test_record;
 namespace shm = handtrack::ipc::shm;
@@ -83,7 +84,7 @@ std::vector<std::uint64_t> valid_image(std::uint32_t capacity) {
   h->abi_version = HANDTRACK_ABI_VERSION;
   h->endian_marker = shm::kEndianMarker;
   h->header_size = sizeof(shm::Header);
-  h->record_size = sizeof(PoseRecord);
+  h->record_size = sizeof(FrameRecord);
   h->slot_size = sizeof(shm::Slot);
   h->capacity = capacity;
   h->total_size = shm::segment_size(capacity);
@@ -120,10 +121,13 @@ TEST(IpcValidate, AcceptsAValidImageAndRejectsEachCorruption) {
          HANDTRACK_ERR_NOT_READY, "not initialized");
   expect([](shm::Header& h) { h.endian_marker = 0x04030201; }, HANDTRACK_ERR_BAD_ENDIANNESS,
          "0x04030201");
-  expect([](shm::Header& h) { h.abi_version = 2; }, HANDTRACK_ERR_BAD_VERSION, "version is 2");
+  expect([](shm::Header& h) { h.abi_version = 3; }, HANDTRACK_ERR_BAD_VERSION,
+         "segment has ABI version 3, this client reads version 2: rebuild the client against the installed handtrack");
+  expect([](shm::Header& h) { h.abi_version = 1; }, HANDTRACK_ERR_BAD_VERSION,
+         "segment has ABI version 1, this client reads version 2: the running handtrackd is older than this client");
   expect([](shm::Header& h) { h.record_size = 600; }, HANDTRACK_ERR_BAD_RECORD_SIZE,
          "record size is 600");
-  expect([](shm::Header& h) { h.slot_size = 640; }, HANDTRACK_ERR_BAD_LAYOUT, "slot size is 640");
+  expect([](shm::Header& h) { h.slot_size = 704; }, HANDTRACK_ERR_BAD_LAYOUT, "slot size is 704");
   expect([](shm::Header& h) { h.capacity = 0; }, HANDTRACK_ERR_BAD_LAYOUT, "capacity is 0");
   expect([](shm::Header& h) { h.capacity = 5; }, HANDTRACK_ERR_BAD_LAYOUT, "total size");
   expect([](shm::Header& h) { h.heartbeat_period_ns = 0; }, HANDTRACK_ERR_BAD_LAYOUT,
@@ -137,10 +141,10 @@ TEST(IpcRing, PublishedRecordReadsBackWithEpochAndPublishTime) {
   PoseRingWriter writer(options_for(name));
   PoseRingReader reader;
   ASSERT_EQ(reader.open(name.value), HANDTRACK_OK) << reader.error_detail();
-  PoseRecord out{};
+  FrameRecord out{};
   EXPECT_EQ(reader.latest(out), HANDTRACK_NO_RECORD);
 
-  const PoseRecord in = make_test_record(42);
+  const FrameRecord in = make_test_record(42);
   const auto before = std::chrono::steady_clock::now().time_since_epoch().count();
   writer.publish(in);
   ASSERT_EQ(reader.latest(out), HANDTRACK_OK);
@@ -149,7 +153,27 @@ TEST(IpcRing, PublishedRecordReadsBackWithEpochAndPublishTime) {
   EXPECT_EQ(out.epoch, writer.epoch());
   EXPECT_EQ(out.epoch, reader.epoch());
   EXPECT_GE(out.publish_ns, before);  // steady_clock is CLOCK_MONOTONIC on Linux
-  EXPECT_EQ(std::memcmp(out.joints_mm, in.joints_mm, sizeof in.joints_mm), 0);
+  EXPECT_EQ(std::memcmp(out.hands, in.hands, sizeof in.hands), 0);
+}
+
+// A frame's hand_count says how many hands[] are real: 0 for a frame without a hand, and never
+// more than the record holds, even from a writer that says otherwise (readers loop up to it).
+TEST(IpcRing, HandCountIsReadBackAndNeverExceedsTheRecord) {
+  ShmName name;
+  PoseRingWriter writer(options_for(name));
+  PoseRingReader reader;
+  ASSERT_EQ(reader.open(name.value), HANDTRACK_OK) << reader.error_detail();
+  FrameRecord in{};
+  in.frame = 1;
+  writer.publish(in);
+  FrameRecord out{};
+  ASSERT_EQ(reader.wait_next(out, 0ms), HANDTRACK_OK);
+  EXPECT_EQ(out.hand_count, 0U);
+  in.frame = 2;
+  in.hand_count = 7;
+  writer.publish(in);
+  ASSERT_EQ(reader.wait_next(out, 0ms), HANDTRACK_OK);
+  EXPECT_EQ(out.hand_count, handtrack::ipc::kMaxHands);
 }
 
 TEST(IpcRing, InOrderReaderCountsOverwrittenRecordsAsMissed) {
@@ -157,7 +181,7 @@ TEST(IpcRing, InOrderReaderCountsOverwrittenRecordsAsMissed) {
   PoseRingWriter writer(options_for(name, 8));
   PoseRingReader reader;
   ASSERT_EQ(reader.open(name.value), HANDTRACK_OK);
-  PoseRecord out{};
+  FrameRecord out{};
   for (std::uint64_t f = 0; f < 3; ++f) writer.publish(make_test_record(f));
   for (std::uint64_t f = 0; f < 3; ++f) {
     ASSERT_EQ(reader.wait_next(out, 0ns), HANDTRACK_OK);
@@ -183,7 +207,7 @@ TEST(IpcRing, LatestSkipsToTheNewestAndCountsTheSkipped) {
   PoseRingWriter writer(options_for(name, 8));
   PoseRingReader reader;
   ASSERT_EQ(reader.open(name.value), HANDTRACK_OK);
-  PoseRecord out{};
+  FrameRecord out{};
   for (std::uint64_t f = 0; f < 5; ++f) writer.publish(make_test_record(f));
   ASSERT_EQ(reader.latest(out), HANDTRACK_OK);
   EXPECT_EQ(out.frame, 4U);
@@ -204,7 +228,7 @@ TEST(IpcRing, OpenStartsAfterTheNewestRecordPresent) {
   writer.publish(make_test_record(1));
   PoseRingReader reader;
   ASSERT_EQ(reader.open(name.value), HANDTRACK_OK);
-  PoseRecord out{};
+  FrameRecord out{};
   EXPECT_EQ(reader.wait_next(out, 0ns), HANDTRACK_TIMEOUT);
   writer.publish(make_test_record(2));
   ASSERT_EQ(reader.wait_next(out, 0ns), HANDTRACK_OK);
@@ -216,7 +240,7 @@ TEST(IpcWait, TimesOutAfterTheTimeoutWhileTheWriterIsAlive) {
   PoseRingWriter writer(options_for(name));
   PoseRingReader reader;
   ASSERT_EQ(reader.open(name.value), HANDTRACK_OK);
-  PoseRecord out{};
+  FrameRecord out{};
   const auto t0 = std::chrono::steady_clock::now();
   EXPECT_EQ(reader.wait_next(out, 30ms), HANDTRACK_TIMEOUT);
   const double waited = seconds_since(t0);
@@ -233,7 +257,7 @@ TEST(IpcWait, WakesWhenAnotherThreadPublishes) {
     std::this_thread::sleep_for(50ms);
     writer.publish(make_test_record(9));
   });
-  PoseRecord out{};
+  FrameRecord out{};
   const auto t0 = std::chrono::steady_clock::now();
   const Status status = reader.wait_next(out, 5s);
   const double waited = seconds_since(t0);
@@ -250,7 +274,7 @@ TEST(IpcLiveness, StoppedWriterIsReportedAtOnceThenWaitedOut) {
   PoseRingReader reader;
   ASSERT_EQ(reader.open(name.value), HANDTRACK_OK);
   writer.mark_stopped();
-  PoseRecord out{};
+  FrameRecord out{};
   auto t0 = std::chrono::steady_clock::now();
   EXPECT_EQ(reader.wait_next(out, 2s), HANDTRACK_ERR_WRITER_STOPPED);
   EXPECT_LT(seconds_since(t0), 0.5);
@@ -271,7 +295,7 @@ TEST(IpcLiveness, SilentWriterIsReportedDeadWithinThreeHeartbeatPeriods) {
   ASSERT_EQ(reader.open(name.value), HANDTRACK_OK);
   writer.publish(make_test_record(0));  // the last sign of life
   const auto last_beat = std::chrono::steady_clock::now();
-  PoseRecord out{};
+  FrameRecord out{};
   ASSERT_EQ(reader.wait_next(out, 0ns), HANDTRACK_OK);
   EXPECT_EQ(reader.wait_next(out, 2s), HANDTRACK_ERR_WRITER_DEAD);
   const double after = seconds_since(last_beat);
@@ -299,7 +323,7 @@ TEST(IpcLiveness, HeartbeatsKeepAnIdleWriterAlive) {
       std::this_thread::sleep_for(10ms);
     }
   });
-  PoseRecord out{};
+  FrameRecord out{};
   const Status status = reader.wait_next(out, 250ms);
   done = true;
   beater.join();
@@ -350,7 +374,7 @@ TEST(IpcRestart, NewWriterGetsALargerEpochAndReadersFollowIt) {
   ASSERT_TRUE(second.replaced_epoch().has_value());
   EXPECT_EQ(*second.replaced_epoch(), first_epoch);
   second.publish(make_test_record(100));
-  PoseRecord out{};
+  FrameRecord out{};
   ASSERT_EQ(reader.wait_next(out, 1s), HANDTRACK_OK);  // reattached on its own
   EXPECT_EQ(out.frame, 100U);
   EXPECT_EQ(out.epoch, second.epoch());
@@ -372,7 +396,7 @@ TEST(IpcRestart, WaitingReaderIsWokenByTheReplacingWriter) {
     second.publish(make_test_record(5));
     std::this_thread::sleep_for(300ms);
   });
-  PoseRecord out{};
+  FrameRecord out{};
   const auto t0 = std::chrono::steady_clock::now();
   const Status status = reader.wait_next(out, 3s);
   const double waited = seconds_since(t0);
@@ -411,7 +435,7 @@ TEST(IpcOwnership, GarbageUnderTheNameIsReplaced) {
   writer.publish(make_test_record(3));
   PoseRingReader reader;
   ASSERT_EQ(reader.open(name.value), HANDTRACK_OK) << reader.error_detail();
-  PoseRecord out{};
+  FrameRecord out{};
   ASSERT_EQ(reader.latest(out), HANDTRACK_OK);
   EXPECT_EQ(out.frame, 3U);
 }
@@ -460,8 +484,13 @@ TEST(IpcOpen, CorruptOrMissingSegmentsAreRefusedWithAClearError) {
   const Case cases[] = {
       {"magic", [](shm::Header& h) { h.magic.store(42, std::memory_order_relaxed); },
        HANDTRACK_ERR_BAD_MAGIC, "not a handtrack segment"},
-      {"version", [](shm::Header& h) { h.abi_version = 99; }, HANDTRACK_ERR_BAD_VERSION,
-       "ABI version is 99"},
+      // A v2 client meeting a newer segment (what a v1 client meets on a v2 daemon's segment), and
+      // an older one: refused, and the message names both versions and what to do.
+      {"newer version", [](shm::Header& h) { h.abi_version = 3; }, HANDTRACK_ERR_BAD_VERSION,
+       "has ABI version 3, this client reads version 2: rebuild the client against the installed handtrack"},
+      {"older version", [](shm::Header& h) { h.abi_version = 1; }, HANDTRACK_ERR_BAD_VERSION,
+       "has ABI version 1, this client reads version 2: the running handtrackd is older than this client; "
+       "upgrade and restart it"},
       {"record size", [](shm::Header& h) { h.record_size = 512; }, HANDTRACK_ERR_BAD_RECORD_SIZE,
        "record size is 512"},
   };
@@ -488,7 +517,7 @@ TEST(IpcOpen, CorruptOrMissingSegmentsAreRefusedWithAClearError) {
     PoseRingWriter writer(options_for(name, 64));
     {
       bip::shared_memory_object object(bip::open_only, name.value.c_str(), bip::read_write);
-      object.truncate(static_cast<bip::offset_t>(shm::segment_size(64) - 704 * 10));
+      object.truncate(static_cast<bip::offset_t>(shm::segment_size(64) - sizeof(shm::Slot) * 10));
     }
     EXPECT_EQ(reader.open(name.value), HANDTRACK_ERR_TRUNCATED);
     EXPECT_NE(reader.error_detail().find("truncated"), std::string::npos) << reader.error_detail();
@@ -502,31 +531,42 @@ TEST(IpcCApi, ReadsRecordsAndReportsMissed) {
   PoseRingWriter writer(options_for(name, 4));
   handtrack_client* client = nullptr;
   ASSERT_EQ(handtrack_open(name.value.c_str(), &client), HANDTRACK_OK);
-  handtrack_pose pose{};
-  EXPECT_EQ(handtrack_latest(client, &pose), HANDTRACK_NO_RECORD);
+  handtrack_frame frame{};
+  EXPECT_EQ(handtrack_latest(client, &frame), HANDTRACK_NO_RECORD);
   for (std::uint64_t f = 0; f < 10; ++f) writer.publish(make_test_record(f));
-  ASSERT_EQ(handtrack_wait_next(client, &pose, 0), HANDTRACK_OK);
-  EXPECT_EQ(pose.frame, 7U);  // 10 published into 4 slots: oldest safe is 10 - 4 + 1
+  ASSERT_EQ(handtrack_wait_next(client, &frame, 0), HANDTRACK_OK);
+  EXPECT_EQ(frame.frame, 7U);  // 10 published into 4 slots: oldest safe is 10 - 4 + 1
   EXPECT_EQ(handtrack_missed(client), 7U);
-  ASSERT_EQ(handtrack_latest(client, &pose), HANDTRACK_OK);
-  EXPECT_EQ(pose.frame, 9U);
+  ASSERT_EQ(handtrack_latest(client, &frame), HANDTRACK_OK);
+  EXPECT_EQ(frame.frame, 9U);
+  EXPECT_TRUE(is_whole_test_record(frame));
   EXPECT_EQ(handtrack_missed(client), 1U);
   EXPECT_EQ(handtrack_missed_total(client), 8U);
   handtrack_writer_status status{};
   ASSERT_EQ(handtrack_writer_status_get(client, &status), HANDTRACK_OK);
   EXPECT_EQ(status.records_published, 10U);
-  EXPECT_STREQ(handtrack_state_name(pose.state), "no_hand");  // frame 9: 9 % 3 == 0
+  // Both hands of frame 9 (test_pattern.hpp): hand 1 right recovering, hand 2 left tracking.
+  ASSERT_EQ(frame.hand_count, 2U);
+  EXPECT_EQ(frame.hands[0].hand_id, 1U);
+  EXPECT_STREQ(handtrack_handedness_name(frame.hands[0].handedness), "right");
+  EXPECT_STREQ(handtrack_state_name(frame.hands[0].state), "recovering");
+  EXPECT_EQ(frame.hands[1].hand_id, 2U);
+  EXPECT_STREQ(handtrack_handedness_name(frame.hands[1].handedness), "left");
+  EXPECT_STREQ(handtrack_state_name(frame.hands[1].state), "tracking");
+  EXPECT_STREQ(handtrack_handedness_name(HANDTRACK_HANDEDNESS_UNKNOWN), "unknown");
   EXPECT_STREQ(handtrack_device_state_name(status.device_state), "starting");
-  EXPECT_EQ(handtrack_wait_next(nullptr, &pose, 0), HANDTRACK_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(handtrack_wait_next(nullptr, &frame, 0), HANDTRACK_ERR_INVALID_ARGUMENT);
   EXPECT_EQ(handtrack_open(name.value.c_str(), nullptr), HANDTRACK_ERR_INVALID_ARGUMENT);
-  EXPECT_EQ(handtrack_pose_size(), sizeof(handtrack_pose));
+  EXPECT_EQ(handtrack_frame_size(), sizeof(handtrack_frame));
+  EXPECT_EQ(handtrack_hand_size(), sizeof(handtrack_hand));
+  EXPECT_EQ(handtrack_abi_version(), 2U);
   handtrack_close(client);
   handtrack_close(nullptr);
 }
 
 // In-process concurrency (the part TSan checks): a writer thread at full speed into a 2-slot ring
 // (every publish overwrites the slot a reader most likely copies) and reader threads that check
-// every record they accept.
+// every record they accept, and that its hands are all of its frame.
 TEST(IpcConcurrency, ReaderThreadsNeverAcceptATornRecord) {
   ShmName name;
   PoseRingWriter writer(options_for(name, 2));
@@ -539,12 +579,12 @@ TEST(IpcConcurrency, ReaderThreadsNeverAcceptATornRecord) {
   constexpr int kReaders = 2;
   constexpr std::uint64_t kReadsEach = kUnderTsan ? 20'000 : 100'000;  // TSan: ~20x slower
   std::vector<std::thread> readers;
-  std::vector<std::uint64_t> torn(kReaders, 0), accepted(kReaders, 0), distinct(kReaders, 0);
+  std::vector<std::uint64_t> torn(kReaders, 0), mixed(kReaders, 0), accepted(kReaders, 0), distinct(kReaders, 0);
   for (int r = 0; r < kReaders; ++r) {
     readers.emplace_back([&, r] {
       PoseRingReader reader;
       if (reader.open(name.value) != HANDTRACK_OK) return;
-      PoseRecord out{};
+      FrameRecord out{};
       std::uint64_t last = UINT64_MAX;
       const auto end = std::chrono::steady_clock::now() + 20s;
       while (accepted[r] < kReadsEach && std::chrono::steady_clock::now() < end) {
@@ -552,6 +592,7 @@ TEST(IpcConcurrency, ReaderThreadsNeverAcceptATornRecord) {
         if (s != HANDTRACK_OK) continue;
         ++accepted[r];
         if (!is_whole_test_record(out)) ++torn[r];
+        if (!hands_of_one_frame(out)) ++mixed[r];
         if (out.frame != last) ++distinct[r];
         last = out.frame;
       }
@@ -563,6 +604,7 @@ TEST(IpcConcurrency, ReaderThreadsNeverAcceptATornRecord) {
   for (int r = 0; r < kReaders; ++r) {
     EXPECT_EQ(accepted[r], kReadsEach) << "reader " << r;
     EXPECT_EQ(torn[r], 0U) << "reader " << r;
+    EXPECT_EQ(mixed[r], 0U) << "reader " << r;
     // The readers really raced the writer (latest() may run in bursts while the writer is off-CPU).
     EXPECT_GT(distinct[r], 10U) << "reader " << r;
   }

@@ -30,7 +30,7 @@ in_root getent group handtrack > /dev/null || fail "postinst did not create grou
   || fail "/var/lib/handtrack: $(in_root stat -c '%a %U %G' /var/lib/handtrack)"
 [ "$(in_root systemctl is-enabled handtrackd.service 2>/dev/null)" = enabled ] || fail "handtrackd.service not enabled"
 cache="$(in_root ldconfig -p)"   # not piped into grep -q: with pipefail, SIGPIPE would fail it
-grep -q 'libhandtrack_client.so.1 ' <<< "$cache" || fail "libhandtrack_client.so.1 not in the linker cache"
+grep -q 'libhandtrack_client.so.2 ' <<< "$cache" || fail "libhandtrack_client.so.2 not in the linker cache"
 out="$(in_root systemd-analyze verify /usr/lib/systemd/system/handtrackd.service 2>&1)" \
   || { echo "$out"; fail "systemd-analyze verify of the installed unit"; }
 [ -z "$out" ] || { echo "$out"; fail "systemd-analyze verify warns about the installed unit"; }
@@ -63,9 +63,9 @@ import re, time, urllib.request
 import handtrack
 client = handtrack.Client.wait_for("handtrack-live", timeout=20)
 deadline = time.monotonic() + 20
-poses = [p for _, p in zip(range(3), client.poses(timeout=10))]
-assert len(poses) == 3 and poses[0].state_name in ("tracking", "recovering", "no_hand"), poses
-print("python module read", len(poses), "poses from the installed daemon")
+frames = [f for _, f in zip(range(3), client.frames(timeout=10))]
+assert len(frames) == 3 and all(h.handedness in ("left", "right") for f in frames for h in f.hands), frames
+print("python module read", len(frames), "frames from the installed daemon")
 while not re.search(r":([0-9]+)/", open("/tmp/ws.out").read()):
     assert time.monotonic() < deadline, open("/tmp/ws.out").read()
     time.sleep(0.1)

@@ -31,7 +31,7 @@ has /usr/lib/sysusers.d/handtrack.conf
 has /usr/lib/tmpfiles.d/handtrack.conf
 has /etc/handtrack/handtrackd.toml
 has /usr/include/handtrack/client.h
-has '/usr/lib(/[a-z0-9_-]+)?/libhandtrack_client.so.1'
+has '/usr/lib(/[a-z0-9_-]+)?/libhandtrack_client.so.2'
 has '/usr/lib(/[a-z0-9_-]+)?/cmake/handtrack/handtrackConfig.cmake'
 has '/usr/lib(/[a-z0-9_-]+)?/pkgconfig/handtrack.pc'
 has /usr/lib/python3/dist-packages/handtrack/__init__.py

@@ -20,7 +20,7 @@ for f in sbin/handtrackd bin/handtrack-cat include/handtrack/client.h include/ha
          share/doc/handtrack/SERVICE.md; do
   [ -e "$prefix/$f" ] || fail "$f not installed"
 done
-libdir="$(dirname "$(find "$prefix" -name 'libhandtrack_client.so.1' | head -n1)")"
+libdir="$(dirname "$(find "$prefix" -name 'libhandtrack_client.so.2' | head -n1)")"
 [ -f "$libdir/cmake/handtrack/handtrackConfig.cmake" ] || fail "no CMake package in $libdir"
 [ -f "$libdir/pkgconfig/handtrack.pc" ] || fail "no pkg-config file in $libdir"
 grep -qx "ExecStart=$prefix/sbin/handtrackd --config $prefix/etc/handtrack/handtrackd.toml" \
@@ -53,32 +53,41 @@ trap cleanup EXIT
 export LD_LIBRARY_PATH="$libdir"
 "$prefix/bin/handtrack-cat" --shm-name "$name" --count 1 --timeout 20 > /dev/null || fail "no pose from the installed handtrackd"
 
-# "frame N STATE index tip X Y Z mm ..." lines: COUNT of them, frames increasing, a tracked hand
-# somewhere in the working volume (150-600 mm, docs/TRACKER.md).
+# "frame N (missed M): hand ID HANDEDNESS STATE index tip X Y Z mm ...[; hand ...]" or
+# "frame N (missed M): no hand" lines: COUNT of them, frames increasing, a tracked hand (the
+# synthetic camera's right hand) somewhere in the working volume (150-600 mm, docs/TRACKER.md).
 check_lines() {
   local file="$1" count="$2"
   python3 - "$file" "$count" <<'PY'
 import re, sys
 lines = open(sys.argv[1]).read().splitlines()
 want = int(sys.argv[2])
-pat = re.compile(r"^frame (\d+) +(no_hand|tracking|recovering) +index tip +(-?[\d.]+) +(-?[\d.]+) +(-?[\d.]+) mm")
+frame_pat = re.compile(r"^frame (\d+) \(missed \d+\): (.*)$")
+hand_pat = re.compile(r"^hand ([1-9]\d*) (left|right) (tracking|recovering) index tip "
+                      r"(-?[\d.]+) (-?[\d.]+) (-?[\d.]+) mm")
 frames, tracked = [], 0
 for line in lines:
-    m = pat.match(line)
+    m = frame_pat.match(line)
     if not m:
         sys.exit(f"FAIL: {sys.argv[1]}: unexpected line '{line}'")
     frames.append(int(m.group(1)))
-    if m.group(2) == "tracking":
-        tracked += 1
-        if not 100.0 <= float(m.group(5)) <= 700.0:
-            sys.exit(f"FAIL: {sys.argv[1]}: index tip depth {m.group(5)} mm outside the working volume")
+    if m.group(2) == "no hand":
+        continue
+    for part in m.group(2).split("; "):
+        h = hand_pat.match(part)
+        if not h:
+            sys.exit(f"FAIL: {sys.argv[1]}: unexpected hand '{part}' in '{line}'")
+        if h.group(3) == "tracking" and h.group(2) == "right":
+            tracked += 1
+            if not 100.0 <= float(h.group(6)) <= 700.0:
+                sys.exit(f"FAIL: {sys.argv[1]}: index tip depth {h.group(6)} mm outside the working volume")
 if len(lines) != want:
     sys.exit(f"FAIL: {sys.argv[1]}: {len(lines)} lines, expected {want}")
 if frames != sorted(set(frames)):
     sys.exit(f"FAIL: {sys.argv[1]}: frames not increasing: {frames}")
 if tracked == 0:
-    sys.exit(f"FAIL: {sys.argv[1]}: no tracked pose")
-print(f"{sys.argv[1]}: {want} poses, frames {frames[0]}..{frames[-1]}, {tracked} tracked")
+    sys.exit(f"FAIL: {sys.argv[1]}: no tracked right hand")
+print(f"{sys.argv[1]}: {want} frames, frames {frames[0]}..{frames[-1]}, {tracked} tracked right hands")
 PY
 }
 timeout 30 "$work/build/print_poses_c" "$name" 20 > "$work/c.txt" || fail "C example (find_package)"
@@ -93,8 +102,8 @@ PYTHONPATH="$prefix/lib/python3/dist-packages" PYTHONDONTWRITEBYTECODE=1 timeout
   python3 "$ex/handtrack_print_poses.py" --shm-name "$name" --count 20 > "$work/py.txt" || fail "Python example"
 check_lines "$work/py.txt" 20
 
-# Pinch to click: the synthetic pinch closes and opens the hand again and again, so events come
-# as start/end pairs, in frame order, at a position in the working volume.
+# Pinch to click: the synthetic pinch closes and opens the hand again and again, so each hand's
+# events come as start/end pairs, in frame order, at a position in the working volume.
 timeout 90 "$work/build/pinch_click" --shm-name "$name" --events 4 --timeout 20 > "$work/events.txt" \
   || { cat "$work/events.txt"; fail "pinch_click"; }
 timeout 90 "$work/pc_pinch_click" --shm-name "$name" --events 2 --timeout 20 > "$work/events_pc.txt" \
@@ -104,9 +113,14 @@ import json, sys
 for path in sys.argv[1:]:
     events = [json.loads(line) for line in open(path)]
     kinds = [e["event"] for e in events]
-    expected = ["pinch_start", "pinch_end"] * (len(events) // 2)
-    if len(events) < 2 or kinds != expected:
-        sys.exit(f"FAIL: {path}: events {kinds}, expected alternating start/end pairs")
+    if len(events) < 2:
+        sys.exit(f"FAIL: {path}: events {kinds}")
+    for hand_id in {e["hand_id"] for e in events}:
+        mine = [e["event"] for e in events if e["hand_id"] == hand_id]
+        if mine != ["pinch_start", "pinch_end"] * (len(mine) // 2) + ["pinch_start"] * (len(mine) % 2):
+            sys.exit(f"FAIL: {path}: hand {hand_id}: events {mine}, expected alternating start/end")
+    if any(not e["hand_id"] > 0 or e["handedness"] not in ("left", "right") for e in events):
+        sys.exit(f"FAIL: {path}: events without a hand id or handedness: {events}")
     frames = [e["frame"] for e in events]
     if frames != sorted(frames) or len(set(frames)) != len(frames):
         sys.exit(f"FAIL: {path}: frames not increasing: {frames}")

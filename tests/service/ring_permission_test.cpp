@@ -49,8 +49,8 @@ int read_as(const std::string& name, const std::vector<gid_t>& supplementary) {
     const int status = handtrack_open(name.c_str(), &client);
     if (status == HANDTRACK_ERR_PERMISSION) ::_exit(kRefused);
     if (status != HANDTRACK_OK) ::_exit(91);
-    handtrack_pose pose;
-    const int read = handtrack_wait_next(client, &pose, 5'000'000'000LL);
+    handtrack_frame frame;
+    const int read = handtrack_wait_next(client, &frame, 5'000'000'000LL);
     handtrack_close(client);
     ::_exit(read == HANDTRACK_OK ? kReadOk : 92);
   }
@@ -82,8 +82,8 @@ TEST(ServiceRing, GroupMembersReadPosesOthersAreRefused) {
   for (int i = 0; i < 150 && !publishing; ++i) {
     handtrack_client* client = nullptr;
     if (handtrack_open(name.c_str(), &client) == HANDTRACK_OK) {
-      handtrack_pose pose;
-      publishing = handtrack_wait_next(client, &pose, 2'000'000'000LL) == HANDTRACK_OK;
+      handtrack_frame frame;
+      publishing = handtrack_wait_next(client, &frame, 2'000'000'000LL) == HANDTRACK_OK;
       handtrack_close(client);
     }
     if (!publishing) std::this_thread::sleep_for(std::chrono::milliseconds(100));

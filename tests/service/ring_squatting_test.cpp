@@ -92,12 +92,14 @@ class Squatter {
     handtrack::ipc::PoseRingWriter fake(
         handtrack::ipc::PoseRingWriter::Options{.name = name, .capacity = 64, .mode = 0644});
     fake.set_device_state(handtrack::ipc::DeviceState::kStreaming);
-    handtrack::ipc::PoseRecord pose{};
-    pose.state = HANDTRACK_STATE_TRACKING;
-    pose.confidence = 0.99F;
+    handtrack::ipc::FrameRecord frame{};
+    frame.hand_count = 1;
+    frame.hands[0].hand_id = 1;
+    frame.hands[0].state = HANDTRACK_STATE_TRACKING;
+    frame.hands[0].confidence = 0.99F;
     for (std::uint64_t i = 0; i < 32; ++i) {
-      pose.frame = kFakeFrame + i;
-      fake.publish(pose);
+      frame.frame = kFakeFrame + i;
+      fake.publish(frame);
     }
     if (squat == Squat::kStoppedFake) {
       fake.mark_stopped();
@@ -106,8 +108,8 @@ class Squatter {
     }
     (void)!::write(ready, "r", 1);
     for (std::uint64_t i = 32;; ++i) {  // until SIGKILL
-      pose.frame = kFakeFrame + i;
-      fake.publish(pose);
+      frame.frame = kFakeFrame + i;
+      fake.publish(frame);
       std::this_thread::sleep_for(5ms);
     }
   }
@@ -173,9 +175,9 @@ TEST_P(Squatting, RootDaemonReplacesItWithoutTrustingIt) {
   ASSERT_EQ(handtrack_writer_status_get(client, &status), HANDTRACK_OK);
   EXPECT_EQ(status.writer_pid, daemon.pid());
   for (int i = 0; i < 20; ++i) {
-    handtrack_pose pose{};
-    ASSERT_EQ(handtrack_wait_next(client, &pose, 5'000'000'000LL), HANDTRACK_OK) << handtrack_error_detail();
-    ASSERT_LT(pose.frame, kFakeFrame) << "a fake pose was read";
+    handtrack_frame frame{};
+    ASSERT_EQ(handtrack_wait_next(client, &frame, 5'000'000'000LL), HANDTRACK_OK) << handtrack_error_detail();
+    ASSERT_LT(frame.frame, kFakeFrame) << "a fake frame was read";
   }
   handtrack_close(client);
   daemon.signal(SIGTERM);

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Gesture events from asyncio code: smoothed poses from handtrackd, pinch/grab/point starts and
-ends printed as JSON lines (docs/GESTURES.md, docs/FILTER.md).
+"""Gesture events from asyncio code: smoothed frames from handtrackd, each hand's pinch/grab/point
+starts and ends printed as JSON lines (docs/GESTURES.md, docs/FILTER.md).
 
     python3 gestures_async.py [--shm-name NAME] [--seconds S]
 """
@@ -21,11 +21,14 @@ async def main():
     loop = asyncio.get_running_loop()
     stop_at = loop.time() + args.seconds if args.seconds > 0 else None
     with handtrack.Client(args.shm_name) as client:
-        async for pose in client.aposes(timeout=5.0):
-            for name, g in gestures.update(smooth.apply(pose)).items():
-                if g["event"]:
-                    print(json.dumps({"frame": pose.frame, "gesture": name, "event": g["event"],
-                                      "strength": round(g["strength"], 3)}), flush=True)
+        async for frame in client.aframes(timeout=5.0):
+            for hand in gestures.update(smooth.apply(frame)):
+                for name, g in hand["gestures"].items():
+                    if g["event"]:
+                        print(json.dumps({"frame": frame.frame, "hand_id": hand["hand_id"],
+                                          "handedness": hand["handedness"], "gesture": name,
+                                          "event": g["event"], "strength": round(g["strength"], 3)}),
+                              flush=True)
             if stop_at is not None and loop.time() >= stop_at:
                 break
 

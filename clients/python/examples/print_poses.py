@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Print the index fingertip and pinch of live poses from handtrackd (Python example).
+"""Print every hand of live frames from handtrackd: id, handedness, index fingertip, pinch (Python example).
 
     print_poses.py [--shm-name NAME] [--count N]
 """
@@ -22,16 +22,17 @@ def main():
     with client:
         printed = 0
         while printed < args.count:
-            pose = client.wait_next(timeout=2.0)
-            if pose is None:
+            frame = client.wait_next(timeout=2.0)
+            if frame is None:
                 if client.trouble:
                     print("print_poses.py: daemon not alive, waiting", file=sys.stderr)
                     continue
-                print("print_poses.py: no pose for 2 s", file=sys.stderr)
+                print("print_poses.py: no frame for 2 s", file=sys.stderr)
                 return 1
-            x, y, z = pose.fingertips_mm[1]
-            print(f"frame {pose.frame} {pose.state_name:10s} index tip {x:7.1f} {y:7.1f} {z:7.1f} mm"
-                  f"  pinch {pose.pinch_distance_mm:5.1f} mm  missed {client.missed}")
+            hands = [f"hand {hand.hand_id} {hand.handedness} {hand.state_name} index tip "
+                     f"{hand.fingertips_mm[1][0]:.1f} {hand.fingertips_mm[1][1]:.1f} {hand.fingertips_mm[1][2]:.1f} mm"
+                     f" pinch {hand.pinch_distance_mm:.1f} mm" for hand in frame.hands]
+            print(f"frame {frame.frame} (missed {client.missed}): " + ("; ".join(hands) or "no hand"))
             printed += 1
     return 0
 

@@ -1,22 +1,24 @@
 """handtrack: read hand poses published by handtrackd, from Python.
 
-A thin ctypes binding over the stable C library (libhandtrack_client.so, handtrack/client.h):
-the same read-only mapping, seqlock and futex wait as C and C++ clients. The record layout
-below mirrors ``handtrack_pose``; at import the module checks the library's ABI version and
-record size against it and refuses to load on a mismatch.
+A thin ctypes binding over the stable C library (libhandtrack_client.so.2, handtrack/client.h):
+the same read-only mapping, seqlock and futex wait as C and C++ clients. The record layouts
+below mirror ``handtrack_frame`` and ``handtrack_hand`` (shared-memory ABI version 2); at import
+the module checks the library's ABI version and record sizes against them and refuses to load on
+a mismatch.
 
     import handtrack
     with handtrack.Client("handtrack") as client:
-        pose = client.wait_next(timeout=1.0)        # None on timeout
-        if pose is not None:
-            print(pose.frame, pose.state_name, pose.fingertips_mm[1][:])
+        frame = client.wait_next(timeout=1.0)       # None on timeout
+        if frame is not None:
+            for hand in frame.hands:                # every hand of that frame ([] when none)
+                print(frame.frame, hand.hand_id, hand.handedness, hand.state_name, hand.fingertips_mm[1][:])
 
 The library is found through $HANDTRACK_CLIENT_LIB, then the system's library path.
 
-Iterating: ``for pose in client.poses(): ...`` (or ``async for pose in client.aposes()`` in
-asyncio code). With NumPy installed, ``pose.joints``, ``pose.fingertips`` and ``pose.params`` are
-arrays (21x3, 5x3, 26); without it, lists. Smoothing (``PoseFilter``) and gestures (``Gestures``)
-come from the C library.
+Iterating: ``for frame in client.frames(): ...`` (or ``async for frame in client.aframes()`` in
+asyncio code). With NumPy installed, ``hand.joints``, ``hand.fingertips`` and ``hand.pose_params``
+are arrays (21x3, 5x3, 26); without it, lists. Smoothing (``PoseFilter``) and gestures
+(``Gestures``) come from the C library and follow each hand by its ``hand_id``.
 """
 
 import asyncio
@@ -32,11 +34,12 @@ except ImportError:  # NumPy is optional: lists instead of arrays
 
 __version__ = "0.1.0"
 
-__all__ = ["Client", "Pose", "Stats", "WriterStatus", "HandtrackError", "ABI_VERSION",
+__all__ = ["Client", "Frame", "Hand", "Stats", "WriterStatus", "HandtrackError", "ABI_VERSION",
            "TIMEOUT", "NO_RECORD", "ERR_WRITER_DEAD", "ERR_WRITER_STOPPED",
            "ERR_UNTRUSTED_OWNER", "PoseFilter", "FilterParams", "Gestures", "GESTURE_NAMES"]
 
-ABI_VERSION = 1
+ABI_VERSION = 2
+MAX_HANDS = 2
 NUM_PARAMS = 26
 NUM_JOINTS = 21
 NUM_FINGERTIPS = 5
@@ -53,20 +56,16 @@ ERR_UNTRUSTED_OWNER = -15  # the segment's owner is not trusted (HANDTRACK_TRUST
 _Vec3 = ctypes.c_float * 3
 
 
-class Pose(ctypes.Structure):
-    """One pose; same layout as handtrack_pose (640 bytes)."""
+class Hand(ctypes.Structure):
+    """One hand of a frame; same layout as handtrack_hand (640 bytes)."""
     _fields_ = [
-        ("frame", ctypes.c_uint64),
-        ("epoch", ctypes.c_uint64),
-        ("capture_ns", ctypes.c_int64),
-        ("publish_ns", ctypes.c_int64),
-        ("grab_ms", ctypes.c_float),
-        ("preprocess_ms", ctypes.c_float),
-        ("optimize_ms", ctypes.c_float),
-        ("publish_ms", ctypes.c_float),
+        ("hand_id", ctypes.c_uint32),
+        ("handedness_code", ctypes.c_int32),
+        ("handedness_confidence", ctypes.c_float),
         ("state", ctypes.c_int32),
         ("confidence", ctypes.c_float),
         ("energy", ctypes.c_float),
+        ("optimize_ms", ctypes.c_float),
         ("flags", ctypes.c_uint32),
         ("params", ctypes.c_double * NUM_PARAMS),
         ("joints_mm", _Vec3 * NUM_JOINTS),
@@ -76,10 +75,16 @@ class Pose(ctypes.Structure):
         ("pinch_distance_mm", ctypes.c_float),
         ("pinch_strength", ctypes.c_float),
         ("hand_scale", ctypes.c_float * 3),
-        ("reserved", ctypes.c_uint32 * 3),
+        ("reserved", ctypes.c_uint32 * 11),
     ]
 
     STATE_NAMES = {0: "no_hand", 1: "tracking", 2: "recovering"}
+    HANDEDNESS_NAMES = {1: "left", 2: "right"}  # handtrack_handedness; 0 is "unknown"
+
+    @property
+    def handedness(self):
+        """"left" or "right" ("unknown" only for a record without a hand)."""
+        return self.HANDEDNESS_NAMES.get(self.handedness_code, "unknown")
 
     @property
     def joints(self):
@@ -101,15 +106,46 @@ class Pose(ctypes.Structure):
         return self.STATE_NAMES.get(self.state, "unknown")
 
     def to_dict(self):
-        """The fields handtrack-cat prints, as plain Python values."""
+        """The fields handtrack-cat prints for a hand, as plain Python values."""
         return {
-            "frame": self.frame, "epoch": self.epoch, "state": self.state_name,
-            "capture_ns": self.capture_ns, "publish_ns": self.publish_ns,
+            "hand_id": self.hand_id, "handedness": self.handedness,
+            "handedness_confidence": self.handedness_confidence, "state": self.state_name,
             "confidence": self.confidence, "energy": self.energy,
             "params": list(self.params),
             "joints": [list(j) for j in self.joints_mm],
             "fingertips": [list(t) for t in self.fingertips_mm],
             "pinch": {"distance_mm": self.pinch_distance_mm, "strength": self.pinch_strength},
+        }
+
+
+class Frame(ctypes.Structure):
+    """One frame with every hand in it; same layout as handtrack_frame (1336 bytes). All its
+    hands were read together: they belong to this frame."""
+    _fields_ = [
+        ("frame", ctypes.c_uint64),
+        ("epoch", ctypes.c_uint64),
+        ("capture_ns", ctypes.c_int64),
+        ("publish_ns", ctypes.c_int64),
+        ("grab_ms", ctypes.c_float),
+        ("preprocess_ms", ctypes.c_float),
+        ("optimize_ms", ctypes.c_float),
+        ("publish_ms", ctypes.c_float),
+        ("hand_count", ctypes.c_uint32),
+        ("flags", ctypes.c_uint32),
+        ("hand_records", Hand * MAX_HANDS),
+    ]
+
+    @property
+    def hands(self):
+        """The hands seen in this frame (an empty list when none), as Hand objects."""
+        return [self.hand_records[i] for i in range(min(self.hand_count, MAX_HANDS))]
+
+    def to_dict(self):
+        """The fields handtrack-cat prints (without "missed"), as plain Python values."""
+        return {
+            "frame": self.frame, "epoch": self.epoch,
+            "capture_ns": self.capture_ns, "publish_ns": self.publish_ns,
+            "hands": [hand.to_dict() for hand in self.hands],
         }
 
 
@@ -156,7 +192,7 @@ def _load_library():
     found = ctypes.util.find_library("handtrack_client")
     if found:
         candidates.append(found)
-    candidates.append("libhandtrack_client.so.1")
+    candidates.append("libhandtrack_client.so.2")
     errors = []
     for path in candidates:
         try:
@@ -169,14 +205,15 @@ def _load_library():
 
 _lib = _load_library()
 _lib.handtrack_abi_version.restype = ctypes.c_uint32
-_lib.handtrack_pose_size.restype = ctypes.c_size_t
+_lib.handtrack_frame_size.restype = ctypes.c_size_t
+_lib.handtrack_hand_size.restype = ctypes.c_size_t
 _lib.handtrack_writer_status_size.restype = ctypes.c_size_t
 _lib.handtrack_open.argtypes = [ctypes.c_char_p, ctypes.POINTER(ctypes.c_void_p)]
 _lib.handtrack_close.argtypes = [ctypes.c_void_p]
 _lib.handtrack_close.restype = None
-_lib.handtrack_latest.argtypes = [ctypes.c_void_p, ctypes.POINTER(Pose)]
-_lib.handtrack_wait_next.argtypes = [ctypes.c_void_p, ctypes.POINTER(Pose), ctypes.c_int64]
-_lib.handtrack_wait_latest.argtypes = [ctypes.c_void_p, ctypes.POINTER(Pose), ctypes.c_int64]
+_lib.handtrack_latest.argtypes = [ctypes.c_void_p, ctypes.POINTER(Frame)]
+_lib.handtrack_wait_next.argtypes = [ctypes.c_void_p, ctypes.POINTER(Frame), ctypes.c_int64]
+_lib.handtrack_wait_latest.argtypes = [ctypes.c_void_p, ctypes.POINTER(Frame), ctypes.c_int64]
 _lib.handtrack_missed.argtypes = [ctypes.c_void_p]
 _lib.handtrack_missed.restype = ctypes.c_uint64
 _lib.handtrack_missed_total.argtypes = [ctypes.c_void_p]
@@ -200,15 +237,20 @@ _lib.handtrack_filter_free.argtypes = [ctypes.c_void_p]
 _lib.handtrack_filter_free.restype = None
 _lib.handtrack_filter_reset.argtypes = [ctypes.c_void_p]
 _lib.handtrack_filter_reset.restype = None
-_lib.handtrack_filter_apply.argtypes = [ctypes.c_void_p, ctypes.POINTER(Pose)]
+_lib.handtrack_filter_apply.argtypes = [ctypes.c_void_p, ctypes.POINTER(Frame)]
 
 NUM_GESTURES = 3
 GESTURE_NAMES = ("pinch", "grab", "point")  # handtrack_gesture order
 
 
+GESTURE_MAX_STATES = 2 * MAX_HANDS  # HANDTRACK_GESTURE_MAX_STATES
+
+
 class GestureState(ctypes.Structure):
-    """handtrack_gesture_state: strength, active and event (0 none, 1 start, 2 end) per gesture."""
-    _fields_ = [("strength", ctypes.c_float * NUM_GESTURES), ("active", ctypes.c_int32 * NUM_GESTURES),
+    """handtrack_gesture_state: whose (hand_id, handedness, present), then strength, active and
+    event (0 none, 1 start, 2 end) per gesture."""
+    _fields_ = [("hand_id", ctypes.c_uint32), ("handedness", ctypes.c_int32), ("present", ctypes.c_int32),
+                ("strength", ctypes.c_float * NUM_GESTURES), ("active", ctypes.c_int32 * NUM_GESTURES),
                 ("event", ctypes.c_int32 * NUM_GESTURES)]
 
 
@@ -217,15 +259,17 @@ _lib.handtrack_gestures_free.argtypes = [ctypes.c_void_p]
 _lib.handtrack_gestures_free.restype = None
 _lib.handtrack_gestures_reset.argtypes = [ctypes.c_void_p]
 _lib.handtrack_gestures_reset.restype = None
-_lib.handtrack_gestures_update.argtypes = [ctypes.c_void_p, ctypes.POINTER(Pose), ctypes.POINTER(GestureState)]
+_lib.handtrack_gestures_update.argtypes = [ctypes.c_void_p, ctypes.POINTER(Frame), ctypes.POINTER(GestureState)]
+_lib.handtrack_gestures_update.restype = ctypes.c_int
 
 if _lib.handtrack_abi_version() != ABI_VERSION:
     raise ImportError(f"handtrack: library ABI version {_lib.handtrack_abi_version()}, "
-                      f"this module reads version {ABI_VERSION}")
-if _lib.handtrack_pose_size() != ctypes.sizeof(Pose) or \
-        _lib.handtrack_writer_status_size() != ctypes.sizeof(WriterStatus):
-    raise ImportError("handtrack: record layout of the library and this module differ "
-                      f"({_lib.handtrack_pose_size()} vs {ctypes.sizeof(Pose)} bytes)")
+                      f"this module reads version {ABI_VERSION}: install the matching handtrack")
+for _what, _size, _mine in (("frame", _lib.handtrack_frame_size(), ctypes.sizeof(Frame)),
+                            ("hand", _lib.handtrack_hand_size(), ctypes.sizeof(Hand)),
+                            ("writer status", _lib.handtrack_writer_status_size(), ctypes.sizeof(WriterStatus))):
+    if _size != _mine:
+        raise ImportError(f"handtrack: {_what} record of the library is {_size} bytes, this module's {_mine}")
 
 
 def _error(status):
@@ -237,7 +281,7 @@ def _error(status):
 class Client:
     """A read-only connection to one shared-memory pose ring (thread roles: reentrant).
 
-    Methods return a Pose, or None when nothing arrived in time. A dead or stopped daemon is
+    Methods return a Frame, or None when nothing arrived in time. A dead or stopped daemon is
     reported through the `trouble` attribute (ERR_WRITER_DEAD / ERR_WRITER_STOPPED, else OK);
     the client reattaches by itself when the daemon restarts. Other errors raise HandtrackError.
     """
@@ -265,7 +309,7 @@ class Client:
             time.sleep(0.05)
 
     def close(self):
-        if self._handle:
+        if getattr(self, "_handle", None):  # absent when __init__ raised
             _lib.handtrack_close(self._handle)
             self._handle = None
 
@@ -278,10 +322,10 @@ class Client:
     def __del__(self):
         self.close()
 
-    def _result(self, status, pose):
+    def _result(self, status, frame):
         if status == OK:
             self.trouble = OK
-            return pose
+            return frame
         if status in (TIMEOUT, NO_RECORD):
             return None
         if status in (ERR_WRITER_DEAD, ERR_WRITER_STOPPED):
@@ -290,54 +334,54 @@ class Client:
         raise _error(status)
 
     def latest(self):
-        """The newest pose, or None if none was published yet. Never blocks."""
-        pose = Pose()
-        return self._result(_lib.handtrack_latest(self._handle, ctypes.byref(pose)), pose)
+        """The newest frame, or None if none was published yet. Never blocks."""
+        frame = Frame()
+        return self._result(_lib.handtrack_latest(self._handle, ctypes.byref(frame)), frame)
 
     def wait_next(self, timeout=1.0):
-        """The next pose in order, waiting at most `timeout` seconds."""
-        pose = Pose()
-        status = _lib.handtrack_wait_next(self._handle, ctypes.byref(pose), int(timeout * 1e9))
-        return self._result(status, pose)
+        """The next frame in order, waiting at most `timeout` seconds."""
+        frame = Frame()
+        status = _lib.handtrack_wait_next(self._handle, ctypes.byref(frame), int(timeout * 1e9))
+        return self._result(status, frame)
 
     def wait_latest(self, timeout=1.0):
-        """The newest pose newer than the last one returned, waiting at most `timeout` s."""
-        pose = Pose()
-        status = _lib.handtrack_wait_latest(self._handle, ctypes.byref(pose), int(timeout * 1e9))
-        return self._result(status, pose)
+        """The newest frame newer than the last one returned, waiting at most `timeout` s."""
+        frame = Frame()
+        status = _lib.handtrack_wait_latest(self._handle, ctypes.byref(frame), int(timeout * 1e9))
+        return self._result(status, frame)
 
-    def poses(self, timeout=None, latest=False):
-        """Poses in order (the newest only with latest=True), as they come: for ever, or until
+    def frames(self, timeout=None, latest=False):
+        """Frames in order (the newest only with latest=True), as they come: for ever, or until
         `timeout` seconds pass without one. A daemon that dies or restarts is waited for."""
         wait = self.wait_latest if latest else self.wait_next
         quiet_since = time.monotonic()
         while True:
-            pose = wait(timeout=0.25)
-            if pose is not None:
+            frame = wait(timeout=0.25)
+            if frame is not None:
                 quiet_since = time.monotonic()
-                yield pose
+                yield frame
             elif timeout is not None and time.monotonic() - quiet_since >= timeout:
                 return
 
-    __iter__ = poses
+    __iter__ = frames
 
-    async def aposes(self, timeout=None, latest=False):
-        """`poses()` for asyncio: each wait runs in a worker thread, so the event loop stays free.
+    async def aframes(self, timeout=None, latest=False):
+        """`frames()` for asyncio: each wait runs in a worker thread, so the event loop stays free.
         Use one client per task (a client is used by one thread at a time)."""
         loop = asyncio.get_running_loop()
         wait = self.wait_latest if latest else self.wait_next
         quiet_since = time.monotonic()
         while True:
-            pose = await loop.run_in_executor(None, wait, 0.25)
-            if pose is not None:
+            frame = await loop.run_in_executor(None, wait, 0.25)
+            if frame is not None:
                 quiet_since = time.monotonic()
-                yield pose
+                yield frame
             elif timeout is not None and time.monotonic() - quiet_since >= timeout:
                 return
 
     @property
     def missed(self):
-        """Records skipped just before the last pose returned."""
+        """Records (frames) skipped just before the last frame returned."""
         return _lib.handtrack_missed(self._handle)
 
     @property
@@ -364,9 +408,10 @@ class _Owned:
 
 
 class PoseFilter(_Owned):
-    """A One Euro filter over poses (the C library's handtrack_filter; docs/FILTER.md), one per
-    hand. `PoseFilter()` uses the documented defaults; keyword arguments override them, e.g.
-    `PoseFilter(min_cutoff_hz=0.5)`. `apply(pose)` smooths a Pose in place and returns it."""
+    """A One Euro filter over the hands of a stream of frames (the C library's handtrack_filter;
+    docs/FILTER.md), each hand followed by its hand_id. `PoseFilter()` uses the documented
+    defaults; keyword arguments override them, e.g. `PoseFilter(min_cutoff_hz=0.5)`.
+    `apply(frame)` smooths every hand of a Frame in place and returns the frame."""
 
     def __init__(self, **params):
         p = FilterParams()
@@ -382,9 +427,9 @@ class PoseFilter(_Owned):
             raise HandtrackError(status, f"PoseFilter: invalid parameters {params}")
         self._handle = handle
 
-    def apply(self, pose):
-        _lib.handtrack_filter_apply(self._handle, ctypes.byref(pose))
-        return pose
+    def apply(self, frame):
+        _lib.handtrack_filter_apply(self._handle, ctypes.byref(frame))
+        return frame
 
     _free = _lib.handtrack_filter_free
 
@@ -393,10 +438,13 @@ class PoseFilter(_Owned):
 
 
 class Gestures(_Owned):
-    """Gestures of one hand (the C library's handtrack_gestures; docs/GESTURES.md).
+    """Gestures of every hand of a stream of frames (the C library's handtrack_gestures;
+    docs/GESTURES.md), each hand followed by its hand_id.
 
-    `update(pose)` returns a dict per gesture name: {"strength": 0..1, "active": bool,
-    "event": None | "start" | "end"}, with the library's hysteresis."""
+    `update(frame)` returns one dict per hand: the frame's hands in its order, then the hands
+    that left in this frame (their gestures end there):
+    {"hand_id": 3, "handedness": "right", "present": True,
+     "gestures": {name: {"strength": 0..1, "active": bool, "event": None | "start" | "end"}}}."""
 
     _EVENTS = {0: None, 1: "start", 2: "end"}
 
@@ -406,13 +454,18 @@ class Gestures(_Owned):
         if status != OK:
             raise _error(status)
         self._handle = handle
-        self._state = GestureState()
+        self._states = (GestureState * GESTURE_MAX_STATES)()
 
-    def update(self, pose):
-        _lib.handtrack_gestures_update(self._handle, ctypes.byref(pose), ctypes.byref(self._state))
-        return {name: {"strength": self._state.strength[g], "active": bool(self._state.active[g]),
-                       "event": self._EVENTS.get(self._state.event[g])}
-                for g, name in enumerate(GESTURE_NAMES)}
+    def update(self, frame):
+        n = _lib.handtrack_gestures_update(self._handle, ctypes.byref(frame), self._states)
+        if n < 0:
+            raise _error(n)
+        return [{"hand_id": s.hand_id, "handedness": Hand.HANDEDNESS_NAMES.get(s.handedness, "unknown"),
+                 "present": bool(s.present),
+                 "gestures": {name: {"strength": s.strength[g], "active": bool(s.active[g]),
+                                     "event": self._EVENTS.get(s.event[g])}
+                              for g, name in enumerate(GESTURE_NAMES)}}
+                for s in self._states[:n]]
 
     _free = _lib.handtrack_gestures_free
 

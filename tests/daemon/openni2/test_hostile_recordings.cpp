@@ -163,8 +163,8 @@ TEST(HostileRecordings, AHelperKilledWhileStreamingLeavesTheDaemonAliveSayingErr
     std::this_thread::sleep_for(50ms);
   }
   ASSERT_NE(client, nullptr) << daemon.err();
-  handtrack_pose pose{};
-  ASSERT_EQ(handtrack_wait_next(client, &pose, 10'000'000'000LL), HANDTRACK_OK) << daemon.err();
+  handtrack_frame frame{};
+  ASSERT_EQ(handtrack_wait_next(client, &frame, 10'000'000'000LL), HANDTRACK_OK) << daemon.err();
   const pid_t helper = helper_of(daemon.pid());
   ASSERT_GT(helper, 0) << "no helper process under the daemon";
   ASSERT_EQ(::kill(helper, SIGSEGV), 0);

@@ -1,5 +1,5 @@
 // Google Benchmark: what a client pays to read, and what the writer pays to publish.
-//   BM_ReadLatest      PoseRingReader::latest() of a 640-byte record (target: <= 100 ns median)
+//   BM_ReadLatest      PoseRingReader::latest() of a 1336-byte frame record, two hands (target: <= 100 ns median)
 //   BM_CReadLatest     the same through the C API (handtrack_latest)
 //   BM_TryNextNothing  polling for a record that is not there yet
 //   BM_Publish         PoseRingWriter::publish() including the FUTEX_WAKE system call
@@ -17,7 +17,7 @@
 
 namespace {
 
-using handtrack::ipc::PoseRecord;
+using handtrack::ipc::FrameRecord;
 using handtrack::ipc::PoseRingReader;
 using handtrack::ipc::PoseRingWriter;
 
@@ -40,7 +40,7 @@ void BM_ReadLatest(benchmark::State& state) {
   Ring ring;
   PoseRingReader reader;
   if (reader.open(ring.name) != HANDTRACK_OK) state.SkipWithError("open failed");
-  PoseRecord out;
+  FrameRecord out;
   for (auto _ : state) {
     benchmark::DoNotOptimize(reader.latest(out));
     benchmark::ClobberMemory();
@@ -52,7 +52,7 @@ void BM_CReadLatest(benchmark::State& state) {
   Ring ring;
   handtrack_client* client = nullptr;
   if (handtrack_open(ring.name.c_str(), &client) != HANDTRACK_OK) state.SkipWithError("open failed");
-  handtrack_pose out;
+  handtrack_frame out;
   for (auto _ : state) {
     benchmark::DoNotOptimize(handtrack_latest(client, &out));
     benchmark::ClobberMemory();
@@ -65,14 +65,14 @@ void BM_TryNextNothing(benchmark::State& state) {
   Ring ring;
   PoseRingReader reader;
   if (reader.open(ring.name) != HANDTRACK_OK) state.SkipWithError("open failed");
-  PoseRecord out;
+  FrameRecord out;
   for (auto _ : state) benchmark::DoNotOptimize(reader.try_next(out));
 }
 BENCHMARK(BM_TryNextNothing);
 
 void BM_Publish(benchmark::State& state) {
   Ring ring;
-  const PoseRecord record = handtrack::ipc::test::make_test_record(1);
+  const FrameRecord record = handtrack::ipc::test::make_test_record(1);
   for (auto _ : state) ring.writer.publish(record);
 }
 BENCHMARK(BM_Publish);

@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
     if (::write(ready_pipe[1], &ready, 1) != 1) ::_exit(3);
     std::vector<double> latencies_us;
     latencies_us.reserve(static_cast<std::size_t>(records));
-    handtrack::ipc::PoseRecord record;
+    handtrack::ipc::FrameRecord record;
     while (static_cast<int>(latencies_us.size()) < records) {
       if (reader.wait_next(record, std::chrono::seconds(2)) != HANDTRACK_OK) break;
       latencies_us.push_back(static_cast<double>(now_ns() - record.publish_ns) / 1e3);
@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
   if (::read(ready_pipe[0], &ready, 1) != 1) return 1;
 
   std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  handtrack::ipc::PoseRecord record{};
+  handtrack::ipc::FrameRecord record{};
   for (int i = 0; i < records; ++i) {
     std::this_thread::sleep_for(std::chrono::microseconds(interval_us));  // the reader sleeps
     record.frame = static_cast<std::uint64_t>(i);

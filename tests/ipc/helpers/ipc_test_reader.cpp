@@ -4,13 +4,15 @@
 //                   [--reads K] [--duration-s S] [--epochs E] [--until-stopped] [--timeout-ms T]
 //
 // Checks every accepted record with is_whole_test_record() (a torn record fails) and that its
-// epoch is the mapped segment's. Prints event lines while running:
+// epoch is the mapped segment's, and, on its own, that every hand of the frame carries the frame's
+// number (hands_of_one_frame: a "mixed" frame has hands of different frames). Prints event lines
+// while running:
 //   dead LATENCY_NS        the reader got HANDTRACK_ERR_WRITER_DEAD; now - last heartbeat
 //   stopped                HANDTRACK_ERR_WRITER_STOPPED
 //   epoch E                first record of a new epoch
 //   missed N               a read reported N skipped records
 // and at the end (K reads done, S seconds over, E epochs seen, stopped, or SIGTERM) one line
-//   summary reads=.. torn=.. distinct=.. missed=.. dead=.. stopped=.. epochs=.. max_dead_ns=..
+//   summary reads=.. torn=.. mixed=.. distinct=.. missed=.. dead=.. stopped=.. epochs=.. max_dead_ns=..
 // Mode "unchecked" copies the newest slot WITHOUT the seqlock check: the negative control that
 // shows the checker does see torn records when nothing prevents them.
 #include <handtrack/ipc/pose_ring_reader.hpp>
@@ -43,16 +45,17 @@ std::int64_t now_ns() {
 }
 
 struct Tally {
-  std::uint64_t reads = 0, torn = 0, distinct = 0, missed = 0, dead = 0, stopped = 0, epochs = 0;
+  std::uint64_t reads = 0, torn = 0, mixed = 0, distinct = 0, missed = 0, dead = 0, stopped = 0, epochs = 0;
   std::int64_t max_dead_ns = 0;
   std::uint64_t last_frame = UINT64_MAX;
   std::uint64_t last_epoch = 0;
 };
 
 void print_summary(const Tally& t) {
-  std::printf("summary reads=%llu torn=%llu distinct=%llu missed=%llu dead=%llu stopped=%llu "
+  std::printf("summary reads=%llu torn=%llu mixed=%llu distinct=%llu missed=%llu dead=%llu stopped=%llu "
               "epochs=%llu max_dead_ns=%lld\n",
               static_cast<unsigned long long>(t.reads), static_cast<unsigned long long>(t.torn),
+              static_cast<unsigned long long>(t.mixed),
               static_cast<unsigned long long>(t.distinct), static_cast<unsigned long long>(t.missed),
               static_cast<unsigned long long>(t.dead), static_cast<unsigned long long>(t.stopped),
               static_cast<unsigned long long>(t.epochs), static_cast<long long>(t.max_dead_ns));
@@ -77,13 +80,14 @@ int run_unchecked(const std::string& name, std::uint64_t reads, double duration_
     const std::uint64_t head = header->head.load(std::memory_order_acquire);
     if (head == 0) continue;
     const shm::Slot& slot = slots[(head - 1) % header->capacity];
-    handtrack::ipc::PoseRecord record;
+    handtrack::ipc::FrameRecord record;
     std::uint64_t words[shm::kRecordWords];
     for (std::size_t k = 0; k < shm::kRecordWords; ++k) {
       words[k] = slot.words[k].load(std::memory_order_relaxed);
     }
     std::memcpy(&record, words, sizeof record);
     ++t.reads;
+    if (!handtrack::ipc::test::hands_of_one_frame(record)) ++t.mixed;
     if (!handtrack::ipc::test::is_whole_test_record(record) && ++t.torn >= 100) break;
   }
   print_summary(t);
@@ -129,7 +133,7 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   Tally t;
   const std::int64_t end = now_ns() + static_cast<std::int64_t>(duration_s * 1e9);
-  handtrack::ipc::PoseRecord record;
+  handtrack::ipc::FrameRecord record;
   handtrack::ipc::Status previous = HANDTRACK_OK;
   const auto timeout = std::chrono::milliseconds(timeout_ms);
   while (!g_stop && t.reads < reads && t.epochs < epochs && now_ns() < end) {
@@ -143,6 +147,10 @@ int main(int argc, char** argv) {
       if (!handtrack::ipc::test::is_whole_test_record(record) || record.epoch != reader.epoch()) {
         ++t.torn;
         std::printf("torn frame=%llu\n", static_cast<unsigned long long>(record.frame));
+      }
+      if (!handtrack::ipc::test::hands_of_one_frame(record)) {
+        ++t.mixed;
+        std::printf("mixed frame=%llu\n", static_cast<unsigned long long>(record.frame));
       }
       if (record.epoch != t.last_epoch) {
         t.last_epoch = record.epoch;

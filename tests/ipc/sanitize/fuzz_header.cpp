@@ -3,7 +3,8 @@
 //    bounds (ASan) or hit undefined behaviour (UBSan), and if it accepts, every slot the reader
 //    could index lies inside the bytes.
 // 2. The same bytes as a real shm object, opened by the real client path (PoseRingReader: open,
-//    latest, try_next, wait_next(0), writer_status): no crash, no UB, only status values.
+//    latest, try_next, wait_next(0), writer_status): no crash, no UB, only status values, and a
+//    frame it returns never claims more hands than it holds.
 #include <handtrack/ipc/pose_ring_reader.hpp>
 #include <handtrack/ipc/pose_ring_shm.hpp>
 
@@ -45,10 +46,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     ::close(fd);
     handtrack::ipc::PoseRingReader reader;
     if (reader.open(name) == HANDTRACK_OK) {
-      handtrack::ipc::PoseRecord record;
-      (void)reader.latest(record);
-      (void)reader.try_next(record);
-      (void)reader.wait_next(record, std::chrono::nanoseconds(0));
+      handtrack::ipc::FrameRecord record;
+      const auto check = [&](handtrack::ipc::Status st) {
+        if (st == HANDTRACK_OK && record.hand_count > handtrack::ipc::kMaxHands) std::abort();
+      };
+      check(reader.latest(record));
+      check(reader.try_next(record));
+      check(reader.wait_next(record, std::chrono::nanoseconds(0)));
       handtrack::ipc::WriterStatus status;
       (void)reader.writer_status(status);
     } else if (reader.error_detail().empty()) {

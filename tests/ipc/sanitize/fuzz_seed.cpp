@@ -15,7 +15,7 @@ int main(int argc, char** argv) {
   h->abi_version = HANDTRACK_ABI_VERSION;
   h->endian_marker = shm::kEndianMarker;
   h->header_size = sizeof(shm::Header);
-  h->record_size = sizeof(handtrack::ipc::PoseRecord);
+  h->record_size = sizeof(handtrack::ipc::FrameRecord);
   h->slot_size = sizeof(shm::Slot);
   h->capacity = kCapacity;
   h->total_size = shm::segment_size(kCapacity);

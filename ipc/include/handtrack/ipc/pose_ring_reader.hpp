@@ -42,14 +42,16 @@ class PoseRingReader {
   void close() noexcept;
   [[nodiscard]] bool is_open() const noexcept { return header_ != nullptr; }
 
+  // Every read copies one whole frame record (all its hands, of one frame: one seqlock covers it);
+  // hand_count is never above kMaxHands (a corrupt segment's count is clamped).
   // Copies the newest record (HANDTRACK_NO_RECORD if none yet). Never blocks, never waits.
-  Status latest(PoseRecord& out) noexcept;
+  Status latest(FrameRecord& out) noexcept;
   // Copies the next record in order if it is there (HANDTRACK_TIMEOUT if not). Never blocks.
-  Status try_next(PoseRecord& out) noexcept;
+  Status try_next(FrameRecord& out) noexcept;
   // Waits up to `timeout` for the next record in order (see handtrack_wait_next).
-  Status wait_next(PoseRecord& out, std::chrono::nanoseconds timeout) noexcept;
+  Status wait_next(FrameRecord& out, std::chrono::nanoseconds timeout) noexcept;
   // Waits up to `timeout` for a record newer than the last one returned; returns the newest.
-  Status wait_latest(PoseRecord& out, std::chrono::nanoseconds timeout) noexcept;
+  Status wait_latest(FrameRecord& out, std::chrono::nanoseconds timeout) noexcept;
 
   // The next record in order becomes the oldest one still in the ring (not the next new one).
   void rewind() noexcept;
@@ -67,8 +69,8 @@ class PoseRingReader {
 
  private:
   enum class Mode { kNext, kLatest };
-  Status wait(PoseRecord& out, std::chrono::nanoseconds timeout, Mode mode) noexcept;
-  Status read_index(std::uint64_t index, PoseRecord& out) noexcept;
+  Status wait(FrameRecord& out, std::chrono::nanoseconds timeout, Mode mode) noexcept;
+  Status read_index(std::uint64_t index, FrameRecord& out) noexcept;
   Status writer_trouble(std::int64_t now_ns) const noexcept;  // OK, WRITER_DEAD or WRITER_STOPPED
   bool try_reattach() noexcept;  // true if now mapped to a segment with a new epoch
   Status map(const std::string& name, bool initial);

@@ -5,15 +5,17 @@
 // explicit alignment, native byte order:
 //
 //   offset 0              Header (256 bytes, 4 cache lines)
-//   offset 256            Slot[capacity], 704 bytes each (64-byte aligned)
-//   total_size = 256 + capacity * 704
+//   offset 256            Slot[capacity], 1344 bytes each (21 cache lines, 64-byte aligned)
+//   total_size = 256 + capacity * 1344
 //
-// Every slot is a seqlock (Boehm 2012, "Can seqlocks get along with programming language memory
-// models?", fig. 6/"fences" variant): seq is 0 (never written), 2i+1 (record i being written) or
-// 2i+2 (holds record i, i = 0,1,2,... counts records published in this segment), and the record's
-// 80 words are std::atomic<uint64_t> accessed with memory_order_relaxed, so concurrent reading and
-// writing is race-free in the C++ memory model (and under TSan); the seq values tell a reader
-// whether the words it copied belong to one record. See docs/IPC.md and src/seqlock.hpp.
+// A slot holds one frame record (FrameRecord: the frame's fields and all its hands). Every slot is
+// a seqlock (Boehm 2012, "Can seqlocks get along with programming language memory models?",
+// fig. 6/"fences" variant): seq is 0 (never written), 2i+1 (record i being written) or 2i+2 (holds
+// record i, i = 0,1,2,... counts records published in this segment), and the record's 167 words
+// are std::atomic<uint64_t> accessed with memory_order_relaxed, so concurrent reading and writing
+// is race-free in the C++ memory model (and under TSan); the seq values tell a reader whether the
+// words it copied belong to one record. One seqlock covers the whole frame, so the hands a reader
+// accepts are all of one frame. See docs/IPC.md and src/seqlock.hpp.
 #pragma once
 
 #include <handtrack/ipc/pose_record.hpp>
@@ -29,7 +31,7 @@ namespace handtrack::ipc::shm {
 inline constexpr std::uint64_t kMagic = 0x475245534F505448ULL;
 // Written in native order; reads back as 0x04030201 on a machine of the other byte order.
 inline constexpr std::uint32_t kEndianMarker = 0x01020304U;
-inline constexpr std::size_t kRecordWords = sizeof(PoseRecord) / sizeof(std::uint64_t);
+inline constexpr std::size_t kRecordWords = sizeof(FrameRecord) / sizeof(std::uint64_t);
 inline constexpr std::size_t kStatsWords = sizeof(RingStats) / sizeof(std::uint64_t);
 // Upper bound a reader accepts, so a corrupt header cannot make it compute huge offsets.
 inline constexpr std::uint32_t kMaxCapacity = 1U << 20;
@@ -52,7 +54,7 @@ struct alignas(64) Slot {
   std::atomic<std::uint64_t> seq;
   std::atomic<std::uint64_t> words[kRecordWords];
 };
-static_assert(sizeof(Slot) == 704);
+static_assert(sizeof(Slot) == 1344 && sizeof(Slot) == 8 + sizeof(FrameRecord));
 static_assert(offsetof(Slot, seq) == 0 && offsetof(Slot, words) == 8);
 static_assert(std::is_standard_layout_v<Slot>);
 
@@ -63,7 +65,7 @@ struct alignas(64) Header {
   std::uint32_t abi_version;         // HANDTRACK_ABI_VERSION
   std::uint32_t endian_marker;       // kEndianMarker
   std::uint32_t header_size;         // sizeof(Header)
-  std::uint32_t record_size;         // sizeof(PoseRecord)
+  std::uint32_t record_size;         // sizeof(FrameRecord)
   std::uint32_t slot_size;           // sizeof(Slot)
   std::uint32_t capacity;            // number of slots
   std::uint64_t total_size;          // header_size + capacity * slot_size

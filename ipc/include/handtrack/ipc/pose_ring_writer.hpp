@@ -4,8 +4,8 @@
 //   PoseRingWriter ring(PoseRingWriter::Options{.name = "handtrack", .capacity = 256});
 //   ring.set_device_state(DeviceState::kStreaming);
 //   for (;;) {
-//     PoseRecord pose{};  ... fill frame, capture_ns, timings, state, params, joints ...
-//     ring.publish(pose);          // stamps epoch and publish_ns, wakes waiting clients
+//     FrameRecord frame{};  ... fill frame, capture_ns, timings, hand_count, hands[] ...
+//     ring.publish(frame);         // stamps epoch and publish_ns, wakes waiting clients
 //     ring.heartbeat();            // also call it when idle, at least every heartbeat_period
 //     ring.set_stats(stats);       // about once a second
 //   }
@@ -54,9 +54,9 @@ class PoseRingWriter {
   PoseRingWriter(const PoseRingWriter&) = delete;
   PoseRingWriter& operator=(const PoseRingWriter&) = delete;
 
-  // Copies `pose` into the next slot (overwriting the oldest), stamping epoch and publish_ns
-  // (CLOCK_MONOTONIC), counts as a heartbeat, and wakes waiting readers (FUTEX_WAKE).
-  void publish(const PoseRecord& pose) noexcept;
+  // Copies `frame` (all its hands) into the next slot (overwriting the oldest), stamping epoch and
+  // publish_ns (CLOCK_MONOTONIC), counts as a heartbeat, and wakes waiting readers (FUTEX_WAKE).
+  void publish(const FrameRecord& frame) noexcept;
   // Proves the writer alive; call at least once per heartbeat_period even when no frame arrives.
   void heartbeat() noexcept;
   void set_device_state(DeviceState state) noexcept;
