@@ -306,7 +306,8 @@ PoseParams PoseTracker::initial_pose(const DepthInput& input, const Start& start
   const PosedHand at_origin(model_, params);
   // The segmented palm centre is a surface point; the model's palm centre lies behind it: half a
   // palm thickness behind the palm or the back, half the palm's width behind an edge. A closed hand
-  // shows its curled fingers, which lie in front of the palm by about two finger thicknesses.
+  // with its palm toward the camera shows its curled fingers, which lie in front of the palm by
+  // about two finger thicknesses.
   // (Measured the other way, as the depth of the posed model's nearest surface along the ray
   // through its palm centre, this put the fists of fingercount 75 mm off.)
   const double palm_half_thickness = model_.gaussians().back().sigma_mm;  // the knuckle row's
@@ -315,9 +316,11 @@ PoseParams PoseTracker::initial_pose(const DepthInput& input, const Start& start
     if (g.bone != kPalmBone) continue;
     palm_half_width = std::max(palm_half_width, std::abs(g.palm_position.x()) + g.sigma_mm);
   }
+  // cos(turn): 1 with the palm toward the camera, -1 with the back (the curled fingers behind it).
+  const double palm_toward = std::max(0.0, std::cos(start.turn_rad));
   const double facing = std::abs(std::cos(start.turn_rad));
-  const double behind_surface = facing * (palm_half_thickness + (start.closed ? kClosedFingersInFrontMm : 0.0)) +
-                                (1.0 - facing) * palm_half_width;
+  const double behind_surface = facing * palm_half_thickness + (1.0 - facing) * palm_half_width +
+                                (start.closed ? palm_toward * kClosedFingersInFrontMm : 0.0);
   const Vector3d target = input.palm_centre_mm + Vector3d(0, 0, behind_surface);
   const Vector3d centre = at_origin.camera_R_hand() * model_.palm_centre();
   params.segment<3>(kTranslationParam) = target - centre;
