@@ -21,10 +21,12 @@ constexpr std::array<bool, 2> kStartClosed = {false, true};
 // side-on was fitted as a flattened hand of the other side (docs/TRACKER.md, "Every view").
 constexpr std::array<double, 4> kStartTurns = {0.0, std::numbers::pi, 0.5 * std::numbers::pi,
                                                -0.5 * std::numbers::pi};
-// A check of a tracked pose (a suspect fit) tries the palm and the back only: with the edges too,
-// depth-only tracking of `random` and `tigergrasp` drifted off for good after checks that an edge
-// hypothesis won. A hand lost for good starts again from all turns.
-constexpr size_t kCheckTurns = 4;
+// (Re)start search by successive halving (PoseTracker::restart): every hypothesis gets this many
+// iterations first, and only the best few the rest of TrackerConfig::init_iterations.
+constexpr int kScreenIterations = 15;
+constexpr size_t kRefinedStarts = 3;
+// Hypotheses at most: 2 (in the image plane, along the 3D axis) x turns x closed x rotations.
+constexpr size_t kMaxStarts = 2 * kStartTurns.size() * kStartClosed.size() * kStartRotations.size();
 // A hand whose segmented axis points this much toward or away from the camera (|a_z|, the sine of
 // the angle out of the image plane: 45 deg) is also started with its fingers along that axis in 3D:
 // a hand reaching forward under a head-mounted camera, fingers pointing at a desk camera.
@@ -248,7 +250,9 @@ PoseTracker::PoseTracker(TrackerConfig config)
       guided_energy_(SimilarityFactor::kDepthAndLabel, config.weights),
       common_energy_(SimilarityFactor::kDepthAndLabel, config.weights, config.fusion_label_weight),
       optimizer_(config.optimizer),
-      rng_(config.seed) {}
+      rng_(config.seed) {
+  screened_.reserve(kMaxStarts);
+}
 
 void PoseTracker::set_scale(const HandScale& scale) {
   config_.scale = scale;
@@ -417,7 +421,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   bool started = false;
   CheckOutcome check = CheckOutcome::kNone;
   if (!previous_) {
-    best = restart(input, kStartTurns.size()).result;
+    best = restart(input).result;
     started = true;
     recovering_ = true;
   } else {
@@ -447,7 +451,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     // A suspected gross error: the tracked pose competes with the (re)start hypotheses on this
     // freshly segmented frame; a (re)start replaces it only when it explains more of the hand, so
     // a check cannot make good tracking worse by this measure.
-    const Fit fresh = restart(input, kCheckTurns);
+    const Fit fresh = restart(input);
     check = fresh.explained.score() > explained.score() ? CheckOutcome::kRestartWon : CheckOutcome::kTrackedKept;
     if (check == CheckOutcome::kRestartWon) {
       best = fresh.result;
@@ -489,7 +493,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   return out;
 }
 
-PoseTracker::Fit PoseTracker::restart(const DepthInput& input, size_t turns) {
+PoseTracker::Fit PoseTracker::restart(const DepthInput& input) {
   // The hypotheses are compared by confidence, not energy: E_sim has no notion of occlusion, so
   // a wrong pose that pushes the big palm Gaussians onto the visible surface can out-score the right
   // one (seen on fists), while it explains little of the hand's outline. No temporal prior: the
@@ -497,28 +501,42 @@ PoseTracker::Fit PoseTracker::restart(const DepthInput& input, size_t turns) {
   // energy (Sec. 4.3): the part labels say where the palm and each finger are, which the open and
   // closed hands do not know (docs/TRACKER.md "Recovery": 17 of 21 knocked-off trackers back
   // within 30 frames with the depth-only energy, 21 with this one).
+  //
+  // Successive halving: every hypothesis gets kScreenIterations, then only the kRefinedStarts best
+  // (by fit score) get the rest of init_iterations. All hypotheses to the end cost 24-48 x 80
+  // iterations, 40-100 ms on one frame at every start and suspect-fit check.
   const EnergyFrame frame{&model_, &input, nullptr, nullptr};
   const PoseEnergy& energy = fuses(input) ? guided_energy_ : energy_;
-  Fit best;
   const bool out_of_plane = std::abs(input.finger_axis.z()) >= kOutOfPlaneAxisMinZ;
+  const auto fit = [&](const PoseParams& from, int iterations) {
+    const auto r = optimizer_.maximise(energy, frame, from, scratch_, iterations);
+    scratch_.update(model_, r.params);
+    return Fit{r, explain(input, scratch_)};
+  };
+  // Better by score; on a tie (the same share explained), by energy.
+  const auto better = [](const Fit& a, const Fit& b) {
+    return a.explained.score() > b.explained.score() + 1e-9 ||
+           (a.explained.score() > b.explained.score() - 1e-9 && a.result.energy > b.result.energy);
+  };
+  screened_.clear();
   for (bool along_axis_3d : {false, true}) {
     if (along_axis_3d && !out_of_plane) continue;
-    for (size_t t = 0; t < turns; ++t) {
-      const double turn = kStartTurns[t];
+    for (double turn : kStartTurns) {
       for (bool closed : kStartClosed) {
         for (double offset : kStartRotations) {
           const Start start{offset, closed, turn, along_axis_3d};
-          const auto r = optimizer_.maximise(energy, frame, initial_pose(input, start), scratch_,
-                                             config_.init_iterations);
-          scratch_.update(model_, r.params);
-          const Explained e = explain(input, scratch_);
-          const double c = e.score();
-          if (c > best.explained.score() + 1e-9 || (c > best.explained.score() - 1e-9 && r.energy > best.result.energy)) {
-            best = Fit{r, e};
-          }
+          screened_.push_back(fit(initial_pose(input, start), std::min(kScreenIterations, config_.init_iterations)));
         }
       }
     }
+  }
+  const auto refined = std::min(kRefinedStarts, screened_.size());
+  std::partial_sort(screened_.begin(), screened_.begin() + static_cast<std::ptrdiff_t>(refined), screened_.end(), better);
+  Fit best;
+  for (size_t k = 0; k < refined; ++k) {
+    const int rest = config_.init_iterations - kScreenIterations;
+    const Fit f = rest > 0 ? fit(screened_[k].result.params, rest) : screened_[k];
+    if (better(f, best)) best = f;
   }
   return best;
 }

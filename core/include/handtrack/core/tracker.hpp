@@ -171,9 +171,8 @@ class PoseTracker {
     OptimizerResult result{PoseParams::Zero(), -1e300};
     Explained explained{-1.0, -1.0};
   };
-  // Sec. 5's start: the (re)start hypotheses of the first `turns` turns about the finger axis
-  // optimised on `input`, the best by confidence.
-  Fit restart(const DepthInput& input, size_t turns);
+  // Sec. 5's start: the (re)start hypotheses optimised on `input`, the best by fit score.
+  Fit restart(const DepthInput& input);
   // After a frame's fit: tracks the running confidence level and decides whether the next frame
   // checks the tracked pose against a (re)start.
   enum class CheckOutcome { kNone, kTrackedKept, kRestartWon };
@@ -190,6 +189,7 @@ class PoseTracker {
   PoseEnergy common_energy_;     // late fusion: compares the particles (label share fusion_label_weight)
   AdaptiveGradientAscent optimizer_;
   PosedHand scratch_;
+  std::vector<Fit> screened_;  // restart()'s hypotheses after their first iterations
   std::mt19937_64 rng_;
   std::optional<PoseParams> previous_;
   std::optional<PoseParams> before_previous_;
