@@ -1,11 +1,11 @@
 // The pose filter of the C API (handtrack/client.h, handtrack_filter_*): a One Euro filter
 // (one_euro.hpp) on every point of every hand of a frame, each hand followed by its hand_id and
 // reset where its sequence of poses breaks.
+#include "hand_slots.hpp"
 #include "one_euro.hpp"
 
 #include <handtrack/client.h>
 
-#include <algorithm>
 #include <array>
 #include <cmath>
 #include <new>
@@ -15,7 +15,7 @@ namespace {
 using handtrack::ipc::detail::OneEuroParams;
 using handtrack::ipc::detail::OneEuroPoint;
 
-// The filter of one hand: its points and where its sequence of poses stands.
+// The filter of one hand: its points and where its sequence of poses stands (HandFilter{}: afresh).
 struct HandFilter {
   uint32_t hand_id = 0;  // 0: free
   std::array<OneEuroPoint, HANDTRACK_NUM_JOINTS> joints;
@@ -67,40 +67,19 @@ struct handtrack_filter {
   OneEuroParams euro{};
   std::array<HandFilter, HANDTRACK_MAX_HANDS> hands;
 
-  void reset() noexcept {
-    for (HandFilter& h : hands) {
-      h.reset();
-      h.hand_id = 0;
-    }
-  }
+  void reset() noexcept { hands.fill(HandFilter{}); }
 
   void apply(handtrack_frame& frame) noexcept {
-    const uint32_t count = std::min<uint32_t>(frame.hand_count, HANDTRACK_MAX_HANDS);
-    const auto in_frame = [&](uint32_t id) {
-      for (uint32_t i = 0; i < count; ++i) {
-        if (frame.hands[i].hand_id == id) return true;
-      }
-      return false;
-    };
+    using handtrack::ipc::detail::frame_has_hand;
     // A hand missing from this frame has left: its history goes (a returning hand gets a new id).
     for (HandFilter& h : hands) {
-      if (h.hand_id != 0 && !in_frame(h.hand_id)) h.hand_id = 0;
+      if (h.hand_id != 0 && !frame_has_hand(frame, h.hand_id)) h = HandFilter{};
     }
+    const uint32_t count = handtrack::ipc::detail::hand_count(frame);
     for (uint32_t i = 0; i < count; ++i) {
       handtrack_hand& hand = frame.hands[i];
       if (hand.hand_id == 0) continue;  // not a hand (a present hand never has id 0)
-      HandFilter* mine = nullptr;
-      for (HandFilter& h : hands) {
-        if (h.hand_id == hand.hand_id) mine = &h;
-      }
-      if (mine == nullptr) {  // a new hand: a free filter, started afresh
-        for (HandFilter& h : hands) {
-          if (h.hand_id == 0 && mine == nullptr) mine = &h;
-        }
-        mine->hand_id = hand.hand_id;
-        mine->reset();
-      }
-      mine->apply(hand, frame.epoch, frame.capture_ns, params, euro);
+      handtrack::ipc::detail::hand_state(hands, hand.hand_id).apply(hand, frame.epoch, frame.capture_ns, params, euro);
     }
   }
 };

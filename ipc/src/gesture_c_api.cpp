@@ -2,7 +2,10 @@
 // and start/end events with hysteresis, for each hand of a frame by its hand_id (docs/GESTURES.md).
 #include <handtrack/client.h>
 
+#include "hand_slots.hpp"
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <new>
 
@@ -73,7 +76,7 @@ void step(HandGestures& h, bool hand, handtrack_gesture_state& out) {
 
 // The hands of the last update, matched to the next frame's hands by hand_id.
 struct handtrack_gestures {
-  HandGestures hands[HANDTRACK_MAX_HANDS];
+  std::array<HandGestures, HANDTRACK_MAX_HANDS> hands;
 };
 
 extern "C" {
@@ -101,46 +104,34 @@ int handtrack_gestures_new(handtrack_gestures** out) {
 void handtrack_gestures_free(handtrack_gestures* gestures) { delete gestures; }
 
 void handtrack_gestures_reset(handtrack_gestures* gestures) {
-  if (gestures != nullptr) *gestures = handtrack_gestures{};
+  if (gestures != nullptr) gestures->hands.fill(HandGestures{});
 }
 
 int handtrack_gestures_update(handtrack_gestures* gestures, const handtrack_frame* frame,
                               handtrack_gesture_state out[HANDTRACK_GESTURE_MAX_STATES]) {
+  using handtrack::ipc::detail::frame_has_hand;
   if (gestures == nullptr || frame == nullptr || out == nullptr) return HANDTRACK_ERR_INVALID_ARGUMENT;
-  const uint32_t count = std::min<uint32_t>(frame->hand_count, HANDTRACK_MAX_HANDS);
-  int n = 0;
-  // The hands that left first (their slots are then free for new hands), reported after the
+  // The hands that left first (their states are then free for new hands), reported after the
   // frame's own hands.
   handtrack_gesture_state left[HANDTRACK_MAX_HANDS];
   int n_left = 0;
   for (HandGestures& h : gestures->hands) {
-    if (h.hand_id == 0) continue;
-    bool there = false;
-    for (uint32_t i = 0; i < count; ++i) there = there || frame->hands[i].hand_id == h.hand_id;
-    if (there) continue;
+    if (h.hand_id == 0 || frame_has_hand(*frame, h.hand_id)) continue;
     handtrack_gesture_state& s = left[n_left++];
     std::fill(s.strength, s.strength + HANDTRACK_NUM_GESTURES, 0.0F);
     step(h, false, s);
     h = HandGestures{};
   }
+  int n = 0;
+  const uint32_t count = handtrack::ipc::detail::hand_count(*frame);
   for (uint32_t i = 0; i < count; ++i) {
     const handtrack_hand& hand = frame->hands[i];
     if (hand.hand_id == 0) continue;  // not a hand (a present hand never has id 0)
-    HandGestures* mine = nullptr;
-    for (HandGestures& h : gestures->hands) {
-      if (h.hand_id == hand.hand_id) mine = &h;
-    }
-    if (mine == nullptr) {  // a new hand: a free slot, nothing on yet
-      for (HandGestures& h : gestures->hands) {
-        if (h.hand_id == 0 && mine == nullptr) mine = &h;
-      }
-      *mine = HandGestures{};
-      mine->hand_id = hand.hand_id;
-    }
-    mine->handedness = hand.handedness;
+    HandGestures& mine = handtrack::ipc::detail::hand_state(gestures->hands, hand.hand_id);
+    mine.handedness = hand.handedness;
     handtrack_gesture_state& s = out[n++];
     handtrack_gesture_strengths(&hand, s.strength);
-    step(*mine, hand.state != HANDTRACK_STATE_NO_HAND, s);
+    step(mine, hand.state != HANDTRACK_STATE_NO_HAND, s);
   }
   for (int k = 0; k < n_left; ++k) out[n++] = left[k];
   return n;
