@@ -15,12 +15,15 @@
 #include "handtrack/common/cli.hpp"
 #include <fmt/format.h>
 
+#include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <optional>
+#include <thread>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
@@ -68,6 +71,25 @@ std::string record_dir_problem(const std::string& dir) {
   }
   fs::remove(probe, ec);
   return {};
+}
+
+// Pipeline::start() loads the part forest (13 MB: about half a second, more on a busy machine)
+// before the source starts, while the ring already exists: a client that opens it meanwhile would
+// call a writer silent for 2.5 heartbeat periods dead (docs/IPC.md). So a helper thread keeps the
+// heartbeat going until start() returns; the main loop takes over from there.
+bool start_beating(Pipeline& pipeline, ipc::PoseRingWriter& ring, std::string* why) {
+  std::atomic<bool> started{false};
+  std::thread beat([&] {
+    // SYNC: relaxed: the flag only ends the loop, it guards no data (join() orders the rest).
+    while (!started.load(std::memory_order_relaxed)) {
+      ring.heartbeat();  // any thread may beat (PoseRingWriter's thread roles)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));  // twice per 100 ms period
+    }
+  });
+  const bool ok = pipeline.start(why);
+  started.store(true, std::memory_order_relaxed);
+  beat.join();
+  return ok;
 }
 
 }  // namespace
@@ -175,7 +197,7 @@ int handtrack::daemon::run_handtrackd(int argc, char** argv, const SourceFactory
 
   Pipeline pipeline(config, std::move(source_ptr), *ring);
   std::string why;
-  if (!pipeline.start(&why)) {
+  if (!start_beating(pipeline, *ring, &why)) {
     ring.reset();
     ipc::PoseRingWriter::remove(config.shm_name);
     return fail(why);
