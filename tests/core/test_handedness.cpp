@@ -8,6 +8,7 @@
 //   230536/170 the palm-facing right hand explains slightly more of the depth as a left hand seen
 //   from the back (a model of isotropic Gaussians is nearly the same seen from either side), the
 //   failure the issue "Every hand, every view" still has to remove.
+#include "handtrack/core/part_forest.hpp"
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/tracker.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
@@ -16,6 +17,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 namespace handtrack {
@@ -80,14 +82,27 @@ INSTANTIATE_TEST_SUITE_P(
     case_name);
 
 // The SR305's frames, fitted from scratch with the working volume these recordings need
-// (docs/TRACKER.md, "Real frames").
-TEST(RealHands, Sr305FramesAreRightHandsAndTheirMirrorImagesTheOtherHand) {
+// (docs/TRACKER.md, "Real frames"), depth-only and in the shipped configuration (late fusion with
+// the shipped forest). Measured: every frame in the volume but 170 fits as a right hand
+// depth-only, all but 130 and 150 with late fusion (the forest, trained on renders, mislabels real
+// depth; the issue's goal is every frame). The bound: 3 of 4 depth-only, 2 of 3 with late fusion.
+struct RealCase {
+  EnergyMode mode;
+  int min_right_hands_of_12;  // of every 12 frames with a hand, at least this many right hands
+};
+class RealHands : public ::testing::TestWithParam<RealCase> {};
+
+TEST_P(RealHands, Sr305FramesAreRightHandsAndTheirMirrorImagesTheOtherHand) {
   const fs::path dir = fs::path(HANDTRACK_SHARED_DATA_DIR) / "real-sr305" / "20210326-230536";
   if (!fs::exists(dir)) GTEST_SKIP() << "shared data absent: " << dir;
   const CameraIntrinsics cam{Sr305Camera::kWidth, Sr305Camera::kHeight, Sr305Camera::kFx, Sr305Camera::kFy,
                              Sr305Camera::kCx,    Sr305Camera::kCy,     Sr305Camera::kDepthScaleMm, 30};
   TrackerConfig config;
   config.input.far_mm = 800.0;
+  config.mode = GetParam().mode;
+  std::optional<PartForest> forest;
+  if (config.mode == EnergyMode::kLateFusion) forest.emplace(PartForest::load(shipped_forest_path().value()));
+  const PixelLabeller* labeller = forest ? &*forest : nullptr;
   int frames = 0;
   int right_hands = 0;
   for (const auto& entry : fs::directory_iterator(dir)) {
@@ -101,8 +116,8 @@ TEST(RealHands, Sr305FramesAreRightHandsAndTheirMirrorImagesTheOtherHand) {
     }
     Tracker as_seen(config);
     Tracker as_mirrored(config);
-    const TrackerOutput right = as_seen.track(depth);
-    const TrackerOutput left = as_mirrored.track(mirrored);
+    const TrackerOutput right = as_seen.track(depth, labeller);
+    const TrackerOutput left = as_mirrored.track(mirrored, labeller);
     const std::string name = entry.path().filename().string();
     if (right.state == TrackingState::kNoHand) continue;  // beyond the working volume: nothing to say
     ++frames;
@@ -115,8 +130,15 @@ TEST(RealHands, Sr305FramesAreRightHandsAndTheirMirrorImagesTheOtherHand) {
     }
   }
   EXPECT_GE(frames, 6) << "frames with a hand in the working volume";
-  EXPECT_GE(4 * right_hands, 3 * frames) << right_hands << " of " << frames << " frames fit as a right hand";
+  EXPECT_GE(12 * right_hands, GetParam().min_right_hands_of_12 * frames)
+      << right_hands << " of " << frames << " frames fit as a right hand";
 }
+
+INSTANTIATE_TEST_SUITE_P(DepthOnlyAndShipped, RealHands,
+                         ::testing::Values(RealCase{EnergyMode::kDepthOnly, 9}, RealCase{EnergyMode::kLateFusion, 8}),
+                         [](const ::testing::TestParamInfo<RealCase>& c) {
+                           return std::string(c.param.mode == EnergyMode::kLateFusion ? "late_fusion" : "depth_only");
+                         });
 
 }  // namespace
 }  // namespace handtrack

@@ -2,6 +2,7 @@
 #include "render.hpp"
 
 #include "handtrack/core/camera.hpp"
+#include "handtrack/core/part_forest.hpp"
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/core/tracker.hpp"
@@ -50,6 +51,8 @@ struct Args {
   std::optional<double> near_mm, far_mm;
   bool crop = false;
   int panel_height = 0;
+  std::string energy = "late-fusion";
+  std::string forest;
 };
 
 // What the tracker segmented for the hand it reports, in the frame's own image (a left hand's
@@ -68,10 +71,31 @@ handtrack::TrackerConfig tracker_config(const Args& a) {
   if (a.near_mm) config.input.near_mm = *a.near_mm;
   if (a.far_mm) config.input.far_mm = *a.far_mm;
   if (config.input.far_mm <= config.input.near_mm) throw UsageError("--far-mm must be greater than --near-mm");
+  if (a.energy == "late-fusion") config.mode = handtrack::EnergyMode::kLateFusion;
   return config;
 }
 
 handtrack::view::RenderOptions render_options(const Args& a) { return {a.crop, a.panel_height}; }
+
+// The part forest of late fusion (handtrack-eval's rule: --forest, else the shipped one), or none
+// for depth-only.
+std::optional<handtrack::PartForest> load_forest(const Args& a) {
+  if (a.energy != "late-fusion") return std::nullopt;
+  std::string file = a.forest;
+  if (file.empty()) {
+    const auto shipped = handtrack::shipped_forest_path();
+    if (!shipped) {
+      throw UsageError("no part forest found for late fusion: pass --forest MODEL, set $HANDTRACK_FOREST, or use "
+                       "--energy depth-only");
+    }
+    file = shipped->string();
+  }
+  return handtrack::PartForest::load(file);
+}
+
+const handtrack::PixelLabeller* labeller(const std::optional<handtrack::PartForest>& forest) {
+  return forest ? &*forest : nullptr;
+}
 
 // Shows "frame i/n, ETA" on a terminal; silent otherwise (SPEC.md "Programs").
 class Progress {
@@ -118,11 +142,12 @@ int run_sequence(const Args& a) {
   }
   const size_t last = a.frame ? static_cast<size_t>(*a.frame) : count - 1;
   handtrack::Tracker tracker(tracker_config(a));
+  const auto forest = load_forest(a);
   Progress progress(last + 1);
   int written = 0;
   for (size_t i = 0; i <= last; ++i) {
     const handtrack::DepthImage depth = reader.depth(i);
-    const handtrack::TrackerOutput output = tracker.track(depth);
+    const handtrack::TrackerOutput output = tracker.track(depth, labeller(forest));
     progress.step(i + 1);
     const bool wanted = a.every > 0 ? i % static_cast<size_t>(a.every) == 0 || (a.frame && i == last) : i == last;
     if (!wanted) continue;
@@ -194,7 +219,8 @@ int run_single(const Args& a) {
   }
   // One frame: the tracker's (re)start path, the open hand placed at the segmented hand.
   handtrack::Tracker tracker(tracker_config(a));
-  const handtrack::TrackerOutput output = tracker.track(depth);
+  const auto forest = load_forest(a);
+  const handtrack::TrackerOutput output = tracker.track(depth, labeller(forest));
   handtrack::view::FrameView view;
   view.depth = &depth;
   const auto input = tracker_input(tracker, output);
@@ -236,13 +262,19 @@ int main(int argc, char** argv) {
   app.add_option("--iterations", a.iterations, "Optimizer iterations per frame (default 10)")
       ->check(CLI::Range(1, 10000));
   app.add_option("--init-iterations", a.init_iterations,
-                 "Iterations of the (re)start from the open hand, e.g. for a single frame (default 40)")
+                 "Iterations of each (re)start hypothesis, e.g. for a single frame (default 80)")
       ->check(CLI::Range(1, 10000));
   app.add_option("--particles", a.particles, "Pose particles per frame (default 2)")->check(CLI::Range(1, 64));
   app.add_option("--near-mm", a.near_mm, "Near end of the working volume, mm (default 150)")
       ->check(CLI::Range(1.0, 10000.0));
   app.add_option("--far-mm", a.far_mm, "Far end of the working volume, mm (default 600)")
       ->check(CLI::Range(1.0, 10000.0));
+  app.add_option("--energy", a.energy, "late-fusion (default, with the shipped forest) or depth-only")
+      ->check(CLI::IsMember({"late-fusion", "depth-only"}));
+  app.add_option("--forest", a.forest,
+                 "part-classification forest for late fusion (default: the shipped one, $HANDTRACK_FOREST, data/ or "
+                 "/usr/share/handtrack)")
+      ->check(CLI::ExistingFile);
   app.add_flag("--crop", a.crop, "Zoom all panels onto the segmented hand");
   app.add_option("--panel-height", a.panel_height, "Panel height in px (default: image height; 360 with --crop)")
       ->check(CLI::Range(32, 4096));
