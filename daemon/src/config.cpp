@@ -119,7 +119,7 @@ const std::vector<Field>& fields() {
      0, 0, "auto | left | right: which hand the tracker fits (auto: both at every (re)start, the better kept)",
      true},
     {"tracker.init_iterations", IntRef{[](DaemonConfig& c) -> int& { return c.tracker.init_iterations; }}, 1, 1000,
-     "iterations of a (re)start from the open or closed hand", true},
+     "iterations of each (re)start hypothesis (the best 3 of its 24-48; the others 15)", true},
     {"tracker.lost_confidence", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.lost_confidence; }}, 0, 1,
      "confidence below which a frame counts toward a restart", true},
     {"tracker.lost_frames", IntRef{[](DaemonConfig& c) -> int& { return c.tracker.lost_frames; }}, 1, 1000,
