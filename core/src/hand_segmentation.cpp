@@ -23,12 +23,6 @@ constexpr double kWristBelowPalmCentre = 0.25;
 constexpr double kHandLengthMargin = 1.1;
 // The forearm is cut this far below the wrist joint (mm): the wrist's own surface stays in.
 constexpr double kWristCutMarginMm = 10.0;
-// A blob whose outline runs along the far plane of the working volume for more than this share
-// is a larger surface (a shoulder, a desk) reaching into the volume, not a hand in front of one.
-// Measured: synthetic hands with their forearms 0-0.10, the shoulder of the .oni recording
-// 0.18-0.24; a real hand straddling the far plane (SR305 231615/100: 0.25) is missed until it
-// comes nearer, which is what a working volume means.
-constexpr double kMaxFarPlaneCut = 0.15;
 // Pixels this close to the image border mark the end of a blob where the arm leaves the image.
 constexpr int kBorderPx = 3;
 
@@ -166,7 +160,7 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
     }
     return kept;
   };
-  const auto area_mm2 = [&](int pixels, double depth_mm) { return pixels * depth_mm * depth_mm / (cam.fx * cam.fy); };
+  const auto area_mm2 = [&](int pixels, double depth_mm) { return surface_area_mm2(cam, pixels, depth_mm); };
 
   int count = found ? select() : 0;
   if (found && area_mm2(count, centre.z()) < config.min_hand_area_mm2) found = false;
@@ -174,45 +168,12 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
   if (!found) {
     // No usable hint: the nearest sizeable surface in the working volume is the hand (and maybe
     // its forearm). Label 4-connected surfaces whose neighbouring depths differ < continuity_mm.
-    component_.assign(n, -1);
-    struct Blob {
-      int pixels = 0;
-      double depth_sum = 0.0;
-    };
-    std::vector<Blob> blobs;
-    for (size_t seed = 0; seed < n; ++seed) {
-      if (d[seed] <= 0.0F || component_[seed] >= 0) continue;
-      const int id = static_cast<int>(blobs.size());
-      Blob blob;
-      stack_.clear();
-      stack_.push_back(static_cast<int>(seed));
-      component_[seed] = id;
-      while (!stack_.empty()) {
-        const auto i = static_cast<size_t>(stack_.back());
-        stack_.pop_back();
-        ++blob.pixels;
-        blob.depth_sum += d[i];
-        const int u = static_cast<int>(i % w);
-        const int v = static_cast<int>(i / w);
-        const auto visit = [&](int uu, int vv) {
-          if (uu < 0 || vv < 0 || uu >= w || vv >= h) return;
-          const auto j = static_cast<size_t>(vv) * w + uu;
-          if (component_[j] >= 0 || d[j] <= 0.0F || std::abs(d[j] - d[i]) >= config.continuity_mm) return;
-          component_[j] = id;
-          stack_.push_back(static_cast<int>(j));
-        };
-        visit(u - 1, v);
-        visit(u + 1, v);
-        visit(u, v - 1);
-        visit(u, v + 1);
-      }
-      blobs.push_back(blob);
-    }
+    label_surfaces(config, d, w, h, component_, stack_, blobs_);
     int best = -1;
     double best_depth = std::numeric_limits<double>::infinity();
-    for (size_t b = 0; b < blobs.size(); ++b) {
-      const double mean = blobs[b].depth_sum / blobs[b].pixels;
-      if (area_mm2(blobs[b].pixels, mean) < config.min_hand_area_mm2) continue;
+    for (size_t b = 0; b < blobs_.size(); ++b) {
+      const double mean = blobs_[b].mean_depth();
+      if (area_mm2(blobs_[b].pixels, mean) < config.min_hand_area_mm2) continue;
       if (mean < best_depth) {
         best_depth = mean;
         best = static_cast<int>(b);
@@ -295,7 +256,7 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
     // The wrist sits about half a palm below the palm centre.
     wrist = centre - axis * (kWristBelowPalmCentre * length);
     count = select();
-    if (far_plane_cut_fraction(config, unclamped_mm, out, best) > kMaxFarPlaneCut) count = 0;
+    if (far_plane_cut_fraction(config, unclamped_mm, component_, best, w, h) > kMaxFarPlaneCut) count = 0;
   }
   out.hand_pixels = count;
   out.finger_axis = axis;
@@ -307,17 +268,50 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
   }
 }
 
-double HandSegmenter::far_plane_cut_fraction(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
-                                             const DepthInput& out, int blob) const {
-  const int w = out.camera.width;
-  const int h = out.camera.height;
+void label_surfaces(const DepthInputConfig& config, const std::vector<float>& d, int w, int h, std::vector<int>& component,
+                    std::vector<int>& stack, std::vector<Surface>& surfaces) {
+  const auto n = static_cast<size_t>(w) * h;
+  component.assign(n, -1);
+  surfaces.clear();
+  for (size_t seed = 0; seed < n; ++seed) {
+    if (d[seed] <= 0.0F || component[seed] >= 0) continue;
+    const int id = static_cast<int>(surfaces.size());
+    Surface surface;
+    stack.clear();
+    stack.push_back(static_cast<int>(seed));
+    component[seed] = id;
+    while (!stack.empty()) {
+      const auto i = static_cast<size_t>(stack.back());
+      stack.pop_back();
+      ++surface.pixels;
+      surface.depth_sum += d[i];
+      const int u = static_cast<int>(i % w);
+      const int v = static_cast<int>(i / w);
+      const auto visit = [&](int uu, int vv) {
+        if (uu < 0 || vv < 0 || uu >= w || vv >= h) return;
+        const auto j = static_cast<size_t>(vv) * w + uu;
+        if (component[j] >= 0 || d[j] <= 0.0F || std::abs(d[j] - d[i]) >= config.continuity_mm) return;
+        component[j] = id;
+        stack.push_back(static_cast<int>(j));
+      };
+      visit(u - 1, v);
+      visit(u + 1, v);
+      visit(u, v - 1);
+      visit(u, v + 1);
+    }
+    surfaces.push_back(surface);
+  }
+}
+
+double far_plane_cut_fraction(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
+                              const std::vector<int>& component, int blob, int w, int h) {
   const auto far = static_cast<float>(config.far_mm);
   const auto reach = static_cast<float>(config.far_mm + config.continuity_mm);
   int boundary = 0;
   int continued = 0;
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
-      if (component_[static_cast<size_t>(v) * w + u] != blob) continue;
+      if (component[static_cast<size_t>(v) * w + u] != blob) continue;
       bool edge = false;
       bool beyond = false;
       for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
@@ -325,7 +319,7 @@ double HandSegmenter::far_plane_cut_fraction(const DepthInputConfig& config, con
         const int vv = v + dv;
         if (uu < 0 || vv < 0 || uu >= w || vv >= h) continue;
         const auto j = static_cast<size_t>(vv) * w + uu;
-        if (component_[j] == blob) continue;
+        if (component[j] == blob) continue;
         edge = true;
         beyond = beyond || (unclamped_mm[j] > far && unclamped_mm[j] <= reach);
       }

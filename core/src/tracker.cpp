@@ -408,8 +408,6 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     recovering_ = true;
     TrackerOutput none;  // no pose is invented: everything zero
     none.state = TrackingState::kNoHand;
-    none.joints.fill(Vector3d::Zero());
-    none.fingertips.fill(Vector3d::Zero());
     return none;
   };
   if (!input.has_hand()) return no_hand();

@@ -89,14 +89,27 @@ struct TrackerConfig {
   // check (above), until one wins by the margin.
   double handedness_margin = 0.05;
   int handedness_check_frames = 30;
+  // Hands per frame (HandsTracker; 1..kMaxHands): hands_tracker.hpp.
+  int max_hands = 2;
+  // A surface that a new hand's (re)start found to be no hand is not tried again for this many
+  // frames (HandsTracker).
+  int new_hand_retry_frames = 15;
   uint64_t seed = 1;
 };
+
+// N points at the origin (Eigen leaves a default-constructed vector uninitialised).
+template <size_t N>
+std::array<Eigen::Vector3d, N> zero_points() {
+  std::array<Eigen::Vector3d, N> points;
+  points.fill(Eigen::Vector3d::Zero());
+  return points;
+}
 
 struct TrackerOutput {
   TrackingState state = TrackingState::kNoHand;
   PoseParams params = PoseParams::Zero();
-  Joints joints{};
-  std::array<Eigen::Vector3d, kNumFingers> fingertips{};
+  Joints joints = zero_points<kNumJoints>();
+  std::array<Eigen::Vector3d, kNumFingers> fingertips = zero_points<kNumFingers>();
   Eigen::Vector3d palm_centre = Eigen::Vector3d::Zero();
   Eigen::Vector3d palm_normal = Eigen::Vector3d::Zero();  // out of the palm, camera frame
   double energy = 0.0;

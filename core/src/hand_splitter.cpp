@@ -1,0 +1,227 @@
+#include "hand_splitter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace handtrack {
+
+namespace {
+
+using Eigen::Vector3d;
+
+// A tracked hand claims a surface when at least kMinClaimSamples of its sampled pixels lie within
+// kClaimMm of the hand's last skeleton: the bones run through the fingers' and the palm's middle,
+// about one finger or half a palm thickness (8-15 mm) below the surface, and the hand moves up to
+// ~20 mm between frames at 60 fps in the fast halves of the synthetic motions.
+constexpr double kClaimMm = 40.0;
+constexpr int kMinClaimSamples = 4;
+// Pixels are sampled every kSampleStridePx (at 320 px width; scaled with the width) to find the
+// claims; the pixels of shared surfaces are each assigned.
+constexpr int kSampleStridePx = 2;
+// A new surface whose centroid is this near where one was found to be no hand is not tried again
+// (HandsTracker keeps those places for TrackerConfig::new_hand_retry_frames).
+constexpr double kRejectedRadiusMm = 60.0;
+
+Vector3d unproject(const CameraIntrinsics& cam, int u, int v, float z) {
+  return cam.unproject(static_cast<double>(u), static_cast<double>(v), z);
+}
+
+}  // namespace
+
+Skeleton::Skeleton(const Joints& joints) {
+  // Joint order (SPEC.md): wrist, then per finger (thumb..little) MCP/CMC, PIP, DIP, TIP.
+  int b = 0;
+  for (int f = 0; f < kNumFingers; ++f) {
+    int parent = 0;
+    for (int k = 0; k < 4; ++k) {
+      const int child = 1 + 4 * f + k;
+      from_[static_cast<size_t>(b)] = joints[static_cast<size_t>(parent)];
+      along_[static_cast<size_t>(b)] = joints[static_cast<size_t>(child)] - joints[static_cast<size_t>(parent)];
+      const double l2 = along_[static_cast<size_t>(b)].squaredNorm();
+      inverse_length2_[static_cast<size_t>(b)] = l2 > 0.0 ? 1.0 / l2 : 0.0;
+      parent = child;
+      ++b;
+    }
+  }
+  for (const auto& j : joints) centre_ += j;
+  centre_ /= static_cast<double>(joints.size());
+  for (const auto& j : joints) radius_ = std::max(radius_, (j - centre_).norm());
+}
+
+double Skeleton::distance2(const Vector3d& p) const {
+  // Nearest point of bone a + t (b - a), t in [0, 1]: t = (p - a).(b - a) / |b - a|^2, clamped.
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t b = 0; b < from_.size(); ++b) {
+    const Vector3d ap = p - from_[b];
+    const double t = std::clamp(ap.dot(along_[b]) * inverse_length2_[b], 0.0, 1.0);
+    best = std::min(best, (ap - t * along_[b]).squaredNorm());
+  }
+  return best;
+}
+
+void HandSplitter::claim(const DepthInputConfig& config, const CameraIntrinsics& cam, const HandsRequest& request) {
+  const int w = cam.width;
+  const int h = cam.height;
+  skeletons_.clear();
+  for (int s = 0; s < kMaxHands; ++s) {
+    const auto& slot = request.slots[static_cast<size_t>(s)];
+    skeleton_of_[static_cast<size_t>(s)] = -1;
+    if (s >= request.max_hands || !slot.active) continue;
+    skeleton_of_[static_cast<size_t>(s)] = static_cast<int>(skeletons_.size());
+    skeletons_.emplace_back(slot.joints);
+  }
+  claims_.assign(surfaces_.size(), Claims{});
+  const int stride = std::max(1, kSampleStridePx * w / 320);
+  const double claim2 = kClaimMm * kClaimMm;
+  for (int v = 0; v < h; v += stride) {
+    for (int u = 0; u < w; u += stride) {
+      const auto i = static_cast<size_t>(v) * w + u;
+      const int c = component_[i];
+      if (c < 0) continue;
+      const Vector3d p = unproject(cam, u, v, volume_[i]);
+      Claims& claims = claims_[static_cast<size_t>(c)];
+      ++claims.sampled;
+      claims.point_sum += p;
+      for (int s = 0; s < kMaxHands; ++s) {
+        const int k = skeleton_of_[static_cast<size_t>(s)];
+        if (k < 0) continue;
+        const Skeleton& sk = skeletons_[static_cast<size_t>(k)];
+        const double reach = sk.radius() + kClaimMm;
+        if ((p - sk.centre()).squaredNorm() > reach * reach) continue;
+        if (sk.distance2(p) < claim2) ++claims.samples[static_cast<size_t>(s)];
+      }
+    }
+  }
+  owner_.assign(surfaces_.size(), kNone);
+  for (size_t c = 0; c < surfaces_.size(); ++c) {
+    for (int s = 0; s < kMaxHands; ++s) {
+      if (claims_[c].samples[static_cast<size_t>(s)] < kMinClaimSamples) continue;
+      owner_[c] = owner_[c] == kNone ? s : kShared;
+    }
+  }
+  // A tracked hand that moved farther than the claim distance since its last pose still keeps the
+  // unclaimed sizeable surface nearest to it, within one hand length of where it was.
+  for (int s = 0; s < kMaxHands; ++s) {
+    const int k = skeleton_of_[static_cast<size_t>(s)];
+    if (k < 0 || std::find(owner_.begin(), owner_.end(), s) != owner_.end()) continue;
+    bool shares = false;
+    for (size_t c = 0; c < surfaces_.size(); ++c) {
+      shares = shares || (owner_[c] == kShared && claims_[c].samples[static_cast<size_t>(s)] >= kMinClaimSamples);
+    }
+    if (shares) continue;
+    int nearest = -1;
+    double nearest_mm = config.hand_length_mm;
+    for (size_t c = 0; c < surfaces_.size(); ++c) {
+      if (owner_[c] != kNone || claims_[c].sampled == 0) continue;
+      const Vector3d centroid = claims_[c].point_sum / claims_[c].sampled;
+      const double d = (centroid - skeletons_[static_cast<size_t>(k)].centre()).norm();
+      if (d < nearest_mm &&
+          surface_area_mm2(cam, surfaces_[c].pixels, surfaces_[c].mean_depth()) >= config.min_hand_area_mm2) {
+        nearest = static_cast<int>(c);
+        nearest_mm = d;
+      }
+    }
+    if (nearest >= 0) owner_[static_cast<size_t>(nearest)] = s;
+  }
+}
+
+void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth, const HandsRequest& request,
+                         std::array<DepthImage, kMaxHands>& out, std::array<FrameShare, kMaxHands>& share,
+                         std::array<std::optional<Vector3d>, kMaxHands>& candidate) {
+  const CameraIntrinsics& cam = depth.camera;
+  const int w = cam.width;
+  const int h = cam.height;
+  const auto n = static_cast<size_t>(w) * h;
+  // The surfaces of the median-filtered working volume (as HandSegmenter sees them: flying pixels
+  // between two hands would otherwise join them).
+  const std::vector<float>& median = median_.apply(depth, config.median_radius_px);
+  volume_.resize(n);
+  const auto near = static_cast<float>(config.near_mm);
+  const auto far = static_cast<float>(config.far_mm);
+  for (size_t i = 0; i < n; ++i) volume_[i] = (median[i] >= near && median[i] <= far) ? median[i] : 0.0F;
+  label_surfaces(config, volume_, w, h, component_, stack_, surfaces_);
+  claim(config, cam, request);
+
+  // Each slot's surface(s): an active slot its claimed ones, a free slot one new one.
+  std::array<int, kMaxHands> new_surface{};
+  new_surface.fill(kNone);
+  std::vector<int>& order = stack_;  // candidates, nearest first
+  order.clear();
+  for (size_t c = 0; c < surfaces_.size(); ++c) {
+    const Surface& s = surfaces_[c];
+    if (owner_[c] != kNone || claims_[c].sampled == 0) continue;
+    if (surface_area_mm2(cam, s.pixels, s.mean_depth()) < config.min_hand_area_mm2) continue;
+    if (far_plane_cut_fraction(config, median, component_, static_cast<int>(c), w, h) > kMaxFarPlaneCut) continue;
+    const Vector3d centroid = claims_[c].point_sum / claims_[c].sampled;
+    bool rejected = false;
+    for (int r = 0; r < request.rejected_count; ++r) {
+      rejected = rejected || (centroid - request.rejected[static_cast<size_t>(r)]).norm() < kRejectedRadiusMm;
+    }
+    if (!rejected) order.push_back(static_cast<int>(c));
+  }
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return surfaces_[static_cast<size_t>(a)].mean_depth() < surfaces_[static_cast<size_t>(b)].mean_depth(); });
+  size_t next = 0;
+  int fitted = 0;
+  for (int s = 0; s < kMaxHands; ++s) {
+    const auto& slot = request.slots[static_cast<size_t>(s)];
+    candidate[static_cast<size_t>(s)].reset();
+    share[static_cast<size_t>(s)] = s < request.max_hands && slot.active ? FrameShare::kOwn : FrameShare::kNothing;
+    if (s < request.max_hands && !slot.active && next < order.size()) {
+      const int c = order[next++];
+      new_surface[static_cast<size_t>(s)] = c;
+      share[static_cast<size_t>(s)] = FrameShare::kOwn;
+      const Claims& claims = claims_[static_cast<size_t>(c)];
+      candidate[static_cast<size_t>(s)] = Vector3d(claims.point_sum / claims.sampled);
+    }
+    fitted += share[static_cast<size_t>(s)] == FrameShare::kOwn ? 1 : 0;
+  }
+  // One hand to fit and nothing else sizeable in the working volume: the whole frame, so that one
+  // hand is tracked exactly as with max_hands 1 (masking the frame changes the median filter at the
+  // hand's outline, and a tracker is chaotic enough for that to move whole sequences by mm).
+  if (fitted == 1) {
+    const auto only = static_cast<int>(std::find(share.begin(), share.end(), FrameShare::kOwn) - share.begin());
+    bool alone = true;
+    for (size_t c = 0; c < surfaces_.size(); ++c) {
+      const bool sizeable = surface_area_mm2(cam, surfaces_[c].pixels, surfaces_[c].mean_depth()) >= config.min_hand_area_mm2;
+      const bool its_own = owner_[c] == only || static_cast<int>(c) == new_surface[static_cast<size_t>(only)];
+      alone = alone && (!sizeable || its_own);
+    }
+    if (alone) {
+      share[static_cast<size_t>(only)] = FrameShare::kWhole;
+      return;
+    }
+  }
+
+  for (int s = 0; s < kMaxHands; ++s) {
+    if (share[static_cast<size_t>(s)] != FrameShare::kOwn) continue;
+    DepthImage& mine = out[static_cast<size_t>(s)];
+    mine.camera = cam;
+    mine.depth_mm.assign(n, 0.0F);
+    const int fresh = new_surface[static_cast<size_t>(s)];
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        const auto i = static_cast<size_t>(v) * w + u;
+        const int c = component_[i];
+        if (c < 0) continue;
+        const int owner = owner_[static_cast<size_t>(c)];
+        bool keep = fresh >= 0 ? c == fresh : owner == s;
+        if (fresh < 0 && owner == kShared && claims_[static_cast<size_t>(c)].samples[static_cast<size_t>(s)] >= kMinClaimSamples) {
+          // Touching hands: each pixel to the hand whose skeleton is nearest.
+          const Vector3d p = unproject(cam, u, v, volume_[i]);
+          const double mine2 = skeletons_[static_cast<size_t>(skeleton_of_[static_cast<size_t>(s)])].distance2(p);
+          keep = true;
+          for (int o = 0; o < kMaxHands; ++o) {
+            const int k = skeleton_of_[static_cast<size_t>(o)];
+            if (o == s || k < 0 || claims_[static_cast<size_t>(c)].samples[static_cast<size_t>(o)] < kMinClaimSamples) continue;
+            keep = keep && mine2 <= skeletons_[static_cast<size_t>(k)].distance2(p);
+          }
+        }
+        if (keep) mine.depth_mm[i] = depth.depth_mm[i];
+      }
+    }
+  }
+}
+
+}  // namespace handtrack

@@ -1,0 +1,75 @@
+#pragma once
+// HandSplitter: shares out one frame's depth among the hand slots of a HandsTracker (the steps in
+// hands_tracker.hpp): connected surfaces, claimed by the tracked hands near whose last skeleton
+// they lie, split pixel by pixel between hands that touch, and the nearest unclaimed surface that
+// could be a hand for each free slot. Private to core (HandsInputs); its scratch is reused from
+// frame to frame.
+#include "hand_segmentation.hpp"
+#include "median_filter.hpp"
+
+#include "handtrack/core/hands_tracker.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <optional>
+#include <vector>
+
+namespace handtrack {
+
+// A hand's last pose as line segments (its bones: wrist to each finger's base, then along each
+// finger), for the distance of a point to the hand.
+class Skeleton {
+ public:
+  explicit Skeleton(const Joints& joints);
+  // Squared distance (mm^2) of p to the nearest bone.
+  [[nodiscard]] double distance2(const Eigen::Vector3d& p) const;
+  // A sphere around all joints.
+  [[nodiscard]] const Eigen::Vector3d& centre() const { return centre_; }
+  [[nodiscard]] double radius() const { return radius_; }
+
+ private:
+  static constexpr int kBones = 4 * kNumFingers;
+  std::array<Eigen::Vector3d, kBones> from_{};
+  std::array<Eigen::Vector3d, kBones> along_{};  // bone vector
+  std::array<double, kBones> inverse_length2_{};
+  Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
+  double radius_ = 0.0;
+};
+
+class HandSplitter {
+ public:
+  // Writes share[i], out[i] for kOwn and, for a free slot taking a new surface, that surface's
+  // centroid into candidate[i].
+  void split(const DepthInputConfig& config, const DepthImage& depth, const HandsRequest& request,
+             std::array<DepthImage, kMaxHands>& out, std::array<FrameShare, kMaxHands>& share,
+             std::array<std::optional<Eigen::Vector3d>, kMaxHands>& candidate);
+
+ private:
+  // Per surface: how many sampled pixels lie within the claim distance of each slot's skeleton,
+  // and the sum of the sampled points (its centroid).
+  struct Claims {
+    std::array<int, kMaxHands> samples{};
+    int sampled = 0;
+    Eigen::Vector3d point_sum = Eigen::Vector3d::Zero();
+  };
+  static constexpr int kShared = -2;  // owner_: claimed by more than one slot
+  static constexpr int kNone = -1;
+
+  void claim(const DepthInputConfig& config, const CameraIntrinsics& camera, const HandsRequest& request);
+  // The free slots' surfaces: nearest first, big enough, not a body reaching through the far plane,
+  // not where a surface was recently found to be no hand.
+  void choose_new(const DepthInputConfig& config, const CameraIntrinsics& camera, const HandsRequest& request);
+
+  MedianFilter median_;
+  std::vector<float> volume_;  // median depth in the working volume, 0 outside
+  std::vector<int> component_;
+  std::vector<int> stack_;
+  std::vector<Surface> surfaces_;
+  std::vector<Claims> claims_;
+  std::vector<int> owner_;  // per surface: the owning slot, kShared or kNone
+  std::vector<Skeleton> skeletons_;
+  std::array<int, kMaxHands> skeleton_of_{};  // slot -> index into skeletons_, -1 when free
+};
+
+}  // namespace handtrack

@@ -1,0 +1,140 @@
+// HandsTracker: several hands, each a Tracker in a slot, on their own share of the frame
+// (hand_splitter.hpp).
+#include "handtrack/core/hands_tracker.hpp"
+
+#include "hand_splitter.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+namespace handtrack {
+
+HandsInputs::HandsInputs(const DepthInputConfig& config)
+    : config_(config),
+      splitter_(std::make_unique<HandSplitter>()),
+      inputs_{TrackerInputs(config), TrackerInputs(config)} {
+  static_assert(kMaxHands == 2, "inputs_ lists one TrackerInputs per hand");
+}
+
+HandsInputs::~HandsInputs() = default;
+HandsInputs::HandsInputs(HandsInputs&&) noexcept = default;
+HandsInputs& HandsInputs::operator=(HandsInputs&&) noexcept = default;
+
+void HandsInputs::build(const DepthImage& depth, const HandsRequest& request, const PixelLabeller* labeller) {
+  if (request.max_hands <= 1) {
+    // One hand: the whole frame, exactly as a Tracker alone sees it.
+    inputs_[0].build(depth, request.slots[0].request, labeller);
+    has_.fill(false);
+    has_[0] = true;
+    candidate_.fill(std::nullopt);
+    return;
+  }
+  splitter_->split(config_, depth, request, depth_, share_, candidate_);
+  for (size_t s = 0; s < kMaxHands; ++s) {
+    has_[s] = share_[s] != FrameShare::kNothing;
+    if (has_[s]) {
+      inputs_[s].build(share_[s] == FrameShare::kWhole ? depth : depth_[s], request.slots[s].request, labeller);
+    }
+  }
+}
+
+HandsTracker::HandsTracker(const TrackerConfig& config)
+    : config_(config), max_hands_(std::clamp(config.max_hands, 1, kMaxHands)), inputs_(config.input) {
+  for (size_t s = 0; s < slots_.size(); ++s) {
+    TrackerConfig c = config;
+    c.seed = config.seed + s;  // each hand its own particles
+    slots_[s].tracker = Tracker(c);
+  }
+}
+
+void HandsTracker::reset() {
+  for (Slot& s : slots_) {
+    s.tracker.reset();
+    s.last = TrackerOutput{};
+    s.current = TrackerOutput{};
+    s.id = 0;
+  }
+  rejected_count_ = 0;
+}
+
+HandsRequest HandsTracker::request() const {
+  HandsRequest r;
+  r.max_hands = max_hands_;
+  for (int s = 0; s < max_hands_; ++s) {
+    const Slot& slot = slots_[static_cast<size_t>(s)];
+    auto& out = r.slots[static_cast<size_t>(s)];
+    out.active = slot.id != 0;
+    out.request = slot.tracker.request();
+    out.joints = slot.last.joints;
+  }
+  r.rejected_count = rejected_count_;
+  for (int k = 0; k < rejected_count_; ++k) r.rejected[static_cast<size_t>(k)] = rejected_[static_cast<size_t>(k)].centre;
+  return r;
+}
+
+uint32_t HandsTracker::begin(const HandsInputs& inputs) {
+  fitting_ = 0;
+  for (int s = 0; s < max_hands_; ++s) {
+    Slot& slot = slots_[static_cast<size_t>(s)];
+    slot.current = TrackerOutput{};
+    slot.optimize_ms = 0.0;
+    slot.trying = slot.id == 0 ? inputs.candidate(s) : std::nullopt;
+    if (inputs.has(s)) fitting_ |= 1U << static_cast<unsigned>(s);
+  }
+  return fitting_;
+}
+
+void HandsTracker::fit(int s, const HandsInputs& inputs) {
+  Slot& slot = slots_[static_cast<size_t>(s)];
+  const auto start = std::chrono::steady_clock::now();
+  slot.current = slot.tracker.optimise(inputs.slot(s));
+  slot.optimize_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+HandsOutput HandsTracker::finish() {
+  // Places found to be no hand are forgotten after new_hand_retry_frames frames.
+  int kept = 0;
+  for (int k = 0; k < rejected_count_; ++k) {
+    Rejected r = rejected_[static_cast<size_t>(k)];
+    if (--r.frames_left > 0) rejected_[static_cast<size_t>(kept++)] = r;
+  }
+  rejected_count_ = kept;
+
+  HandsOutput out;
+  for (int s = 0; s < max_hands_; ++s) {
+    Slot& slot = slots_[static_cast<size_t>(s)];
+    if ((fitting_ & (1U << static_cast<unsigned>(s))) == 0) continue;
+    if (slot.current.state == TrackingState::kNoHand) {
+      // Gone (or never a hand): the slot is free and its id retired.
+      if (slot.trying && rejected_count_ < static_cast<int>(rejected_.size())) {
+        rejected_[static_cast<size_t>(rejected_count_++)] = {*slot.trying, config_.new_hand_retry_frames};
+      }
+      slot.id = 0;
+      slot.tracker.reset();
+      slot.last = TrackerOutput{};
+      continue;
+    }
+    if (slot.id == 0) slot.id = ++last_id_;
+    slot.current.hand_id = slot.id;
+    slot.last = slot.current;
+    out.hands[static_cast<size_t>(out.count)] = slot.current;
+    out.optimize_ms[static_cast<size_t>(out.count)] = slot.optimize_ms;
+    ++out.count;
+  }
+  return out;
+}
+
+HandsOutput HandsTracker::optimise(const HandsInputs& inputs) {
+  const uint32_t fitting = begin(inputs);
+  for (int s = 0; s < kMaxHands; ++s) {
+    if ((fitting & (1U << static_cast<unsigned>(s))) != 0) fit(s, inputs);
+  }
+  return finish();
+}
+
+HandsOutput HandsTracker::track(const DepthImage& depth, const PixelLabeller* labeller) {
+  inputs_.build(depth, request(), labeller);
+  return optimise(inputs_);
+}
+
+}  // namespace handtrack
