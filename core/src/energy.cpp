@@ -85,17 +85,34 @@ HANDTRACK_TARGET_CLONES PairSums pair_sums(const ProjectedGaussian& p,
   return {overlap, weight, weight_du, weight_dv, weight_r2, depth_sign};
 }
 
+// The 3D overlap of eq. 8 for one pair of isotropic Gaussians, E_col's and E_hand's, from the
+// squared distance of the centres and the two sigma^2:
+//   D = (2 pi)^(3/2) (s_a^2 s_b^2 / S)^(3/2) exp(-|mu_a - mu_b|^2 / 2S),  S = s_a^2 + s_b^2,
+// with D / S, the factor of the gradient dD/dmu_a = -D (mu_a - mu_b) / S. Pairs further apart than
+// exp(-30) ~ 1e-13 count 0. Inline and branch-free, for the vectorised loops below.
+constexpr double kMaxOverlapExponent = 30.0;
+struct Overlap3d {
+  double d = 0.0;
+  double d_over_s = 0.0;
+};
+inline Overlap3d overlap_3d_pair(double dist2, double sigma2_a, double sigma2_b, double norm_3d) {
+  const double inv_s = 1.0 / (sigma2_a + sigma2_b);
+  const double exponent = 0.5 * dist2 * inv_s;
+  const double k3 = sigma2_a * sigma2_b * inv_s;
+  const double d =
+      exponent > kMaxOverlapExponent ? 0.0 : norm_3d * k3 * std::sqrt(k3) * detail::exp_nonpositive(-exponent);
+  return {d, d * inv_s};
+}
+
 // E_col's pairs go in chunks: their overlaps vectorised into a small buffer, then scattered to
 // the centres' gradients.
 constexpr size_t kCollisionChunk = 128;
 
-// D_ab = (2 pi)^(3/2) (s_a^2 s_b^2 / S)^(3/2) exp(-|mu_a - mu_b|^2 / 2S) of each pair (eq. 8),
-// with the Gaussians' centres and sigma^2 as arrays; stores D_ab / S per pair and returns sum D_ab.
-// Pairs further apart than exp(-30) ~ 1e-13 count 0.
+// D_ab of each pair (eq. 8, overlap_3d_pair), with the Gaussians' centres and sigma^2 as arrays;
+// stores D_ab / S per pair and returns sum D_ab.
 HANDTRACK_TARGET_CLONES double collision_overlaps(
     const CollisionPair* pairs, size_t count, const double* x, const double* y, const double* z,
     const double* sigma2, double* d_over_s) {
-  constexpr double kMaxExponent = 30.0;
   const double norm_3d = std::pow(2.0 * std::numbers::pi, 1.5);
   double energy = 0.0;
 #pragma omp simd reduction(+ : energy)
@@ -105,14 +122,59 @@ HANDTRACK_TARGET_CLONES double collision_overlaps(
     const double dx = x[a] - x[b];
     const double dy = y[a] - y[b];
     const double dz = z[a] - z[b];
-    const double s = sigma2[a] + sigma2[b];
-    const double inv_s = 1.0 / s;
-    const double exponent = 0.5 * (dx * dx + dy * dy + dz * dz) * inv_s;
-    const double k3 = sigma2[a] * sigma2[b] * inv_s;
-    const double d = exponent > kMaxExponent ? 0.0 : norm_3d * k3 * std::sqrt(k3) * detail::exp_nonpositive(-exponent);
-    energy += d;
-    d_over_s[k] = d * inv_s;
+    const Overlap3d o = overlap_3d_pair(dx * dx + dy * dy + dz * dz, sigma2[a], sigma2[b], norm_3d);
+    energy += o.d;
+    d_over_s[k] = o.d_over_s;
   }
+  return energy;
+}
+
+// E_hand's sums for one model Gaussian p against every Gaussian q of the other hand; the weights
+// are -dE_hand/dmu_p before normalising:
+struct ObstacleSums {
+  double overlap = 0.0;    // sum_q D_pq
+  double weight_dx = 0.0;  // sum_q D_pq (x_p - x_q) / S_pq
+  double weight_dy = 0.0;  // sum_q D_pq (y_p - y_q) / S_pq
+  double weight_dz = 0.0;  // sum_q D_pq (z_p - z_q) / S_pq
+};
+
+HANDTRACK_TARGET_CLONES ObstacleSums obstacle_sums(const Vector3d& centre, double sigma2,
+                                                   const HandObstacle& other) {
+  const double norm_3d = std::pow(2.0 * std::numbers::pi, 1.5);
+  const double* const q_x = other.x_mm();
+  const double* const q_y = other.y_mm();
+  const double* const q_z = other.z_mm();
+  const double* const q_sigma2 = other.sigma2_mm2();
+  const auto n = static_cast<size_t>(other.size());
+  const double x = centre.x();
+  const double y = centre.y();
+  const double z = centre.z();
+  double overlap = 0.0;
+  double weight_dx = 0.0;
+  double weight_dy = 0.0;
+  double weight_dz = 0.0;
+#pragma omp simd reduction(+ : overlap, weight_dx, weight_dy, weight_dz)
+  for (size_t k = 0; k < n; ++k) {
+    const double dx = x - q_x[k];
+    const double dy = y - q_y[k];
+    const double dz = z - q_z[k];
+    const Overlap3d o = overlap_3d_pair(dx * dx + dy * dy + dz * dz, sigma2, q_sigma2[k], norm_3d);
+    overlap += o.d;
+    weight_dx += o.d_over_s * dx;
+    weight_dy += o.d_over_s * dy;
+    weight_dz += o.d_over_s * dz;
+  }
+  return {overlap, weight_dx, weight_dy, weight_dz};
+}
+
+// A term differentiated with respect to the model Gaussians' centres, chained to Theta in one pass
+// through the kinematic chain (PosedHand::add_centre_gradients).
+template <class CentresTerm>
+double chain_to_pose(const PosedHand& hand, PoseGradient* gradient, const CentresTerm& evaluate_centres) {
+  if (gradient == nullptr) return evaluate_centres(nullptr);
+  CentreGradients dE_dcentres = CentreGradients::Zero(3, hand.gaussian_count());
+  const double energy = evaluate_centres(&dE_dcentres);
+  hand.add_centre_gradients(dE_dcentres, *gradient);
   return energy;
 }
 
@@ -120,11 +182,8 @@ HANDTRACK_TARGET_CLONES double collision_overlaps(
 
 double SimilarityTerm::evaluate(const HandModel& model, const PosedHand& hand, const DepthInput& input,
                                 PoseGradient* gradient) const {
-  if (gradient == nullptr) return evaluate_centres(model, hand, input, nullptr);
-  CentreGradients dE_dcentres = CentreGradients::Zero(3, hand.gaussian_count());
-  const double energy = evaluate_centres(model, hand, input, &dE_dcentres);
-  hand.add_centre_gradients(dE_dcentres, *gradient);
-  return energy;
+  return chain_to_pose(hand, gradient,
+                       [&](CentreGradients* dE_dcentres) { return evaluate_centres(model, hand, input, dE_dcentres); });
 }
 
 double SimilarityTerm::evaluate_centres(const HandModel& model, const PosedHand& hand, const DepthInput& input,
@@ -174,11 +233,8 @@ double SimilarityTerm::evaluate_centres(const HandModel& model, const PosedHand&
 }
 
 double CollisionTerm::evaluate(const HandModel& model, const PosedHand& hand, PoseGradient* gradient) const {
-  if (gradient == nullptr) return evaluate_centres(model, hand, nullptr);
-  CentreGradients dE_dcentres = CentreGradients::Zero(3, hand.gaussian_count());
-  const double energy = evaluate_centres(model, hand, &dE_dcentres);
-  hand.add_centre_gradients(dE_dcentres, *gradient);
-  return energy;
+  return chain_to_pose(hand, gradient,
+                       [&](CentreGradients* dE_dcentres) { return evaluate_centres(model, hand, dE_dcentres); });
 }
 
 double CollisionTerm::evaluate_centres(const HandModel& model, const PosedHand& hand,
@@ -210,6 +266,77 @@ double CollisionTerm::evaluate_centres(const HandModel& model, const PosedHand& 
       const Vector3d de_da = -d_over_s[k] * inv_norm * (hand.centre(pair.a) - hand.centre(pair.b));
       dE_dcentres->col(pair.a) += de_da;
       dE_dcentres->col(pair.b) -= de_da;
+    }
+  }
+  return energy * inv_norm;
+}
+
+void HandObstacle::assign(const HandModel& model, const PosedHand& hand, bool mirror_x) {
+  const auto n = static_cast<size_t>(hand.gaussian_count());
+  assert(model.gaussians().size() == n && "the posed hand is of this model");
+  x_mm_.resize(n);
+  y_mm_.resize(n);
+  z_mm_.resize(n);
+  sigma_mm_.resize(n);
+  sigma2_mm2_.resize(n);
+  const double sign_x = mirror_x ? -1.0 : 1.0;
+  Vector3d sum = Vector3d::Zero();
+  max_sigma_mm_ = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const Vector3d& c = hand.centre(static_cast<int>(i));
+    x_mm_[i] = sign_x * c.x();
+    y_mm_[i] = c.y();
+    z_mm_[i] = c.z();
+    const double sigma = model.gaussians()[i].sigma_mm;
+    sigma_mm_[i] = sigma;
+    sigma2_mm2_[i] = sigma * sigma;
+    max_sigma_mm_ = std::max(max_sigma_mm_, sigma);
+    sum += centre(static_cast<int>(i));
+  }
+  bound_centre_mm_ = n == 0 ? Vector3d::Zero() : Vector3d(sum / static_cast<double>(n));
+  bound_radius_mm_ = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    bound_radius_mm_ = std::max(bound_radius_mm_, (centre(static_cast<int>(i)) - bound_centre_mm_).norm());
+  }
+}
+
+void HandObstacle::clear() {
+  x_mm_.clear();
+  y_mm_.clear();
+  z_mm_.clear();
+  sigma_mm_.clear();
+  sigma2_mm2_.clear();
+  bound_centre_mm_.setZero();
+  bound_radius_mm_ = 0.0;
+  max_sigma_mm_ = 0.0;
+}
+
+double InterHandCollisionTerm::evaluate(const HandModel& model, const PosedHand& hand, const HandObstacle& other,
+                                        PoseGradient* gradient) const {
+  return chain_to_pose(hand, gradient, [&](CentreGradients* dE_dcentres) {
+    return evaluate_centres(model, hand, other, dE_dcentres);
+  });
+}
+
+double InterHandCollisionTerm::evaluate_centres(const HandModel& model, const PosedHand& hand,
+                                                const HandObstacle& other, CentreGradients* dE_dcentres) const {
+  if (other.empty()) return 0.0;
+  const auto& gaussians = model.gaussians();
+  const double inv_norm = 1.0 / model.self_similarity();
+  const double max_sigma2 = other.max_sigma_mm() * other.max_sigma_mm();
+  double energy = 0.0;
+  for (int i = 0; i < hand.gaussian_count(); ++i) {
+    const Vector3d& c = hand.centre(i);
+    const double sigma = gaussians[static_cast<size_t>(i)].sigma_mm;
+    const double sigma2 = sigma * sigma;
+    // Every pair of this Gaussian counts 0 (|mu_p - mu_q|^2 > 2 S kMaxOverlapExponent) when its
+    // reach, grown by a hair against rounding, misses the other hand's bounding sphere.
+    const double reach_mm = std::sqrt(2.0 * kMaxOverlapExponent * (sigma2 + max_sigma2)) * (1.0 + 1e-9);
+    if ((c - other.bound_centre_mm()).norm() > other.bound_radius_mm() + reach_mm) continue;
+    const ObstacleSums sums = obstacle_sums(c, sigma2, other);
+    energy += sums.overlap;
+    if (dE_dcentres != nullptr) {
+      dE_dcentres->col(i) -= inv_norm * Vector3d(sums.weight_dx, sums.weight_dy, sums.weight_dz);
     }
   }
   return energy * inv_norm;
@@ -273,11 +400,20 @@ double PoseEnergy::evaluate(const EnergyFrame& frame, const PoseParams& params, 
   if (weights_.smoothness != 0.0 && frame.previous != nullptr && frame.before_previous != nullptr) {
     e.smoothness = smoothness_.evaluate(params, *frame.previous, *frame.before_previous, want ? &g_smo : nullptr);
   }
+  // E_hand only with another hand: without one, the sums (and their rounding) are exactly eq. 2's.
+  const bool other_hand = frame.other_hand != nullptr && weights_.inter_hand != 0.0;
+  CentreGradients g_hand;
+  if (other_hand) {
+    if (want) g_hand = CentreGradients::Zero(3, n);
+    e.inter_hand = inter_hand_.evaluate_centres(*frame.model, hand, *frame.other_hand, want ? &g_hand : nullptr);
+  }
   e.total = e.similarity - weights_.collision * e.collision - weights_.limits * e.limits -
             weights_.smoothness * e.smoothness;
+  if (other_hand) e.total -= weights_.inter_hand * e.inter_hand;
   if (want) {
     *gradient = -weights_.limits * g_lim - weights_.smoothness * g_smo;
     g_sim -= weights_.collision * g_col;
+    if (other_hand) g_sim -= weights_.inter_hand * g_hand;
     hand.add_centre_gradients(g_sim, *gradient);
   }
   if (breakdown != nullptr) *breakdown = e;

@@ -63,4 +63,22 @@ double similarity(const HandModel& model, const PosedHand& hand, const DepthInpu
   return energy * inv_norm;
 }
 
+double inter_hand(const HandModel& model, const PosedHand& hand, const HandObstacle& other, PoseGradient* gradient) {
+  const double inv_norm = 1.0 / model.self_similarity();
+  double energy = 0.0;
+  for (int p = 0; p < hand.gaussian_count(); ++p) {
+    const double sigma_p = model.gaussians()[static_cast<size_t>(p)].sigma_mm;
+    Vector3d de_dmu = Vector3d::Zero();
+    for (int q = 0; q < other.size(); ++q) {
+      const Vector3d diff = hand.centre(p) - other.centre(q);
+      const double d = overlap_3d(diff.squaredNorm(), sigma_p, other.sigma_mm(q));
+      energy += d;
+      // dD/dmu_p = -D (mu_p - mu_q) / S
+      de_dmu -= d * diff / (sigma_p * sigma_p + other.sigma_mm(q) * other.sigma_mm(q));
+    }
+    if (gradient != nullptr) hand.add_point_gradient(p, de_dmu * inv_norm, *gradient);
+  }
+  return energy * inv_norm;
+}
+
 }  // namespace handtrack::reference

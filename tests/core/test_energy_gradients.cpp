@@ -46,6 +46,18 @@ DepthInput synthetic_input(const HandModel& model, const PoseParams& pose, std::
   return in;
 }
 
+// The other hand for E_hand: the same model at `other` (its own angles and rotation), moved so that
+// its wrist is `offset_mm` from this hand's. Mirrored, it is a left hand (the right-hand model at
+// x-negated translation, then every centre's x negated): the two hands' thumbs then face each other.
+HandObstacle obstacle_near(const HandModel& model, const PoseParams& pose, PoseParams other,
+                           const Eigen::Vector3d& offset_mm, bool mirror_x) {
+  other.head<3>() = pose.head<3>() + offset_mm;
+  if (mirror_x) other[0] = -other[0];
+  HandObstacle obstacle;
+  obstacle.assign(model, PosedHand(model, other), mirror_x);
+  return obstacle;
+}
+
 // Central differences, one parameter at a time; compares with the analytic gradient.
 void expect_gradient_matches(const std::function<double(const PoseParams&, PoseGradient*)>& f, const PoseParams& x,
                              const char* what) {
@@ -110,6 +122,28 @@ TEST_P(EnergyGradient, EveryTermMatchesFiniteDifferences) {
   const EnergyFrame frame{&model, &input, &prev, &prev2};
   expect_gradient_matches([&](const PoseParams& p, PoseGradient* g) { return total.evaluate(frame, p, hand, g); },
                           pose, "E (eq. 2)");
+
+  // E_hand against another hand overlapping this one: beside it (a second right hand), and a left
+  // hand (mirrored) reaching into it from the thumb side; its pose is one more random pose.
+  const InterHandCollisionTerm inter;
+  for (const bool mirror : {false, true}) {
+    const Eigen::Vector3d offset_mm = mirror ? Eigen::Vector3d(55, 10, 10) : Eigen::Vector3d(45, -10, 15);
+    const HandObstacle other = obstacle_near(model, pose, random_pose(rng), offset_mm, mirror);
+    const char* what = mirror ? "E_hand (mirrored obstacle)" : "E_hand";
+    hand.update(model, pose);
+    EXPECT_GT(inter.evaluate(model, hand, other, nullptr), 1e-3) << what << ": the hands must overlap for a real check";
+    expect_gradient_matches(
+        [&](const PoseParams& p, PoseGradient* g) {
+          hand.update(model, p);
+          return inter.evaluate(model, hand, other, g);
+        },
+        pose, what);
+    EnergyFrame two_hands = frame;
+    two_hands.other_hand = &other;
+    expect_gradient_matches(
+        [&](const PoseParams& p, PoseGradient* g) { return total.evaluate(two_hands, p, hand, g); }, pose,
+        mirror ? "E with E_hand (mirrored obstacle)" : "E with E_hand");
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(RandomPoses, EnergyGradient, ::testing::Range(0, 8));
@@ -154,6 +188,112 @@ TEST(EnergyTerms, CollisionGrowsWhenFingersCross) {
   const double e_open = col.evaluate(model, hand, nullptr);
   hand.update(model, crossed);
   EXPECT_GT(col.evaluate(model, hand, nullptr), 1.5 * e_open);
+}
+
+// A left hand (mirrored obstacle) facing this right hand across x, thumbs toward each other, moved
+// in from far away: E_hand is exactly 0 while they are apart, then positive and growing as the
+// other hand sinks into this one.
+TEST(EnergyTerms, InterHandIsZeroApartAndGrowsAsHandsInterpenetrate) {
+  const HandModel model = HandModel::default_adult();
+  const InterHandCollisionTerm inter;
+  PoseParams pose = PoseParams::Zero();
+  pose.head<3>() << 0, 0, 400;
+  const PosedHand hand(model, pose);
+  double previous = -1.0;
+  for (const double gap_mm :
+       {600.0, 400.0, 300.0, 250.0, 200.0, 160.0, 120.0, 100.0, 90.0, 80.0, 70.0, 60.0, 50.0, 40.0}) {
+    const HandObstacle other = obstacle_near(model, pose, pose, Eigen::Vector3d(gap_mm, 0, 0), true);
+    PoseGradient g = PoseGradient::Zero();
+    const double e = inter.evaluate(model, hand, other, &g);
+    if (gap_mm >= 300.0) {
+      // Beyond every pair's cut-off (exp(-30)): nothing at all, not even the gradient.
+      EXPECT_EQ(e, 0.0) << "wrists " << gap_mm << " mm apart";
+      EXPECT_EQ(g.cwiseAbs().maxCoeff(), 0.0) << "wrists " << gap_mm << " mm apart";
+    } else {
+      EXPECT_GT(e, previous) << "wrists " << gap_mm << " mm apart";
+      if (gap_mm >= 250.0) {
+        EXPECT_LT(e, 1e-9) << "wrists " << gap_mm << " mm apart: the hands are ~100 mm apart";
+      }
+      // E_hand grows as this hand moves toward the other (+x); -w_h E_hand in E pushes it away.
+      if (gap_mm <= 100.0) {
+        EXPECT_GT(g[0], 0.0) << "wrists " << gap_mm << " mm apart";
+      }
+    }
+    previous = e;
+  }
+  // At 40 mm the hands' surfaces (1-sigma spheres) interpenetrate by ~28 mm: E_hand ~0.57, well
+  // above E_col of this whole open hand (~0.02) and of a fist's true pose (up to 0.06,
+  // docs/TRACKER.md), so the optimizer feels it. (At 200 mm the surfaces are ~8 mm apart and
+  // E_hand ~8e-4; at 100 mm they are 8 mm deep and E_hand ~0.06.)
+  EXPECT_GT(previous, 0.3);
+}
+
+// Without another hand PoseEnergy is eq. 2 to the bit; a far hand or w_h = 0 changes nothing
+// either, so single-hand tracking is untouched.
+TEST(EnergyTerms, NoOtherHandLeavesTheEnergyBitIdentical) {
+  std::mt19937_64 rng(31);
+  const HandModel model = HandModel::default_adult({1.05, 0.95, 1.1});
+  for (int k = 0; k < 4; ++k) {
+    const PoseParams pose = random_pose(rng);
+    const DepthInput input = synthetic_input(model, pose, rng);
+    const PoseParams prev = random_pose(rng);
+    const PoseParams prev2 = random_pose(rng);
+    const EnergyWeights weights;
+    const PoseEnergy energy(SimilarityFactor::kDepth, weights);
+    PosedHand hand;
+    const EnergyFrame one_hand{&model, &input, &prev, &prev2};
+    PoseGradient g_one;
+    EnergyBreakdown parts;
+    const double e_one = energy.evaluate(one_hand, pose, hand, &g_one, &parts);
+    EXPECT_EQ(parts.inter_hand, 0.0);
+    // Eq. 2 from the terms, in PoseEnergy's order.
+    hand.update(model, pose);
+    const SimilarityTerm similarity(SimilarityFactor::kDepth, weights.label_radius_mm);
+    const double sim = similarity.evaluate(model, hand, input, nullptr);
+    const double col = CollisionTerm().evaluate(model, hand, nullptr);
+    const double lim = JointLimitTerm().evaluate(model, pose, nullptr);
+    const double smo = SmoothnessTerm(weights.smoothness_translation_per_mm).evaluate(pose, prev, prev2, nullptr);
+    EXPECT_EQ(e_one, sim - weights.collision * col - weights.limits * lim - weights.smoothness * smo);
+
+    PoseParams far_pose = pose;
+    far_pose[0] += 600.0;
+    HandObstacle far;
+    far.assign(model, PosedHand(model, far_pose), false);
+    EnergyFrame with_far = one_hand;
+    with_far.other_hand = &far;
+    PoseGradient g_far;
+    EXPECT_EQ(energy.evaluate(with_far, pose, hand, &g_far), e_one);
+    EXPECT_EQ(g_far, g_one);
+
+    const HandObstacle near = obstacle_near(model, pose, pose, Eigen::Vector3d(50, 0, 0), true);
+    EnergyFrame with_near = one_hand;
+    with_near.other_hand = &near;
+    EnergyWeights no_inter = weights;
+    no_inter.inter_hand = 0.0;
+    PoseGradient g_off;
+    EXPECT_EQ(PoseEnergy(SimilarityFactor::kDepth, no_inter).evaluate(with_near, pose, hand, &g_off), e_one);
+    EXPECT_EQ(g_off, g_one);
+    // ... while with w_h on, the near hand lowers the energy by exactly w_h E_hand.
+    EnergyBreakdown parts_near;
+    const double e_near = energy.evaluate(with_near, pose, hand, nullptr, &parts_near);
+    EXPECT_GT(parts_near.inter_hand, 0.0);
+    EXPECT_NEAR(e_near, e_one - weights.inter_hand * parts_near.inter_hand, 1e-12);
+  }
+}
+
+// assign() reuses the obstacle's storage: no allocation per frame once it has seen one hand.
+TEST(EnergyTerms, ObstacleAssignReusesStorage) {
+  const HandModel model = HandModel::default_adult();
+  PoseParams pose = PoseParams::Zero();
+  pose.head<3>() << 0, 0, 400;
+  HandObstacle other;
+  other.assign(model, PosedHand(model, pose), false);
+  const double* storage = other.x_mm();
+  pose[0] = 30.0;
+  other.assign(model, PosedHand(model, pose), true);
+  EXPECT_EQ(other.x_mm(), storage);
+  EXPECT_EQ(other.size(), static_cast<int>(model.gaussians().size()));
+  EXPECT_DOUBLE_EQ(other.centre(0).x(), -PosedHand(model, pose).centre(0).x());
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 //   preprocessing   DepthInputBuilder::build without and with the part forest, the forest alone
 //   E_sim           energy + gradient per factor, the optimised term and the plain reference
 //   E               PoseEnergy::evaluate (posing the model, every term, the chain rule)
+//   E_hand          the two-hand collision term alone, and E with another hand touching or apart
 //   optimizer       one iteration of the adaptive gradient ascent (two evaluations), and ten
 //
 // Each iteration takes the next frame or (frame, pose) in turn. --forest FILE (before the
@@ -18,6 +19,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -147,6 +149,66 @@ void BM_PoseEnergy(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PoseEnergy)->ArgName("label")->Arg(0)->Arg(1);
+
+// The other hand for E_hand (issue 14): the frame's true pose mirrored (a left hand), its wrist
+// `gap_mm` to this hand's thumb side; 50 mm: the hands interpenetrate by about a finger, 600 mm:
+// far apart. One obstacle per frame, built once.
+const HandObstacle& other_hand(size_t frame, int gap_mm) {
+  static const auto all = [] {
+    std::vector<std::array<HandObstacle, 2>> out(cases().size());
+    for (size_t i = 0; i < cases().size(); ++i) {
+      for (size_t k = 0; k < 2; ++k) {
+        PoseParams other = cases()[i].truth;
+        other[0] = -(other[0] + (k == 0 ? 50.0 : 600.0));
+        out[i][k].assign(model(), PosedHand(model(), other), true);
+      }
+    }
+    return out;
+  }();
+  return all[frame][gap_mm == 50 ? 0 : 1];
+}
+
+// E_hand with its gradient (the optimised term, or the plain reference with range(1) = 1) against
+// another hand range(0) mm away.
+void BM_InterHand(benchmark::State& state) {
+  const InterHandCollisionTerm term;
+  const auto gap_mm = static_cast<int>(state.range(0));
+  const bool plain = state.range(1) != 0;
+  const size_t poses_per_frame = cases().front().poses.size();
+  size_t i = 0;
+  for (auto _ : state) {
+    const auto& c = posed_cases()[i];
+    const HandObstacle& other = other_hand(i / poses_per_frame, gap_mm);
+    PoseGradient g = PoseGradient::Zero();
+    benchmark::DoNotOptimize(plain ? reference::inter_hand(model(), c.hand, other, &g)
+                                   : term.evaluate(model(), c.hand, other, &g));
+    benchmark::DoNotOptimize(g.data());
+    i = (i + 1) % posed_cases().size();
+  }
+}
+BENCHMARK(BM_InterHand)->ArgNames({"gap_mm", "reference"})->Args({50, 0})->Args({600, 0})->Args({50, 1});
+
+// PoseEnergy (depth factor) as BM_PoseEnergy, with another hand range(0) mm away (0: none).
+void BM_PoseEnergyTwoHands(benchmark::State& state) {
+  const PoseEnergy energy(SimilarityFactor::kDepth, EnergyWeights{});
+  const auto gap_mm = static_cast<int>(state.range(0));
+  PosedHand hand;
+  size_t i = 0;
+  size_t k = 0;
+  for (auto _ : state) {
+    const auto& c = cases()[i];
+    EnergyFrame frame{&model(), &c.input, &c.truth, &c.truth};
+    if (gap_mm != 0) frame.other_hand = &other_hand(i, gap_mm);
+    PoseGradient g;
+    benchmark::DoNotOptimize(energy.evaluate(frame, c.poses[k], hand, &g));
+    benchmark::DoNotOptimize(g.data());
+    if (++k == c.poses.size()) {
+      k = 0;
+      i = (i + 1) % cases().size();
+    }
+  }
+}
+BENCHMARK(BM_PoseEnergyTwoHands)->ArgName("gap_mm")->Arg(0)->Arg(50)->Arg(600);
 
 // AdaptiveGradientAscent::maximise from a pose off the truth: range(1) iterations (each one
 // evaluation, plus one at the start).

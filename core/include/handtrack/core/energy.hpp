@@ -3,6 +3,9 @@
 //
 //   E(Theta) = E_sim - w_c E_col - w_l E_lim - w_s E_smo                    (paper eq. 2)
 //
+// and, where another hand is tracked at the same time (issue 14; ours, the paper has one hand),
+// - w_h E_hand, the same Gaussian overlap as E_col between this hand and the other (fixed) one.
+//
 // One class per term; each returns its value and adds its analytic gradient (d term / d Theta)
 // into a PoseGradient when asked. The detection-guided energy of Sec. 4.3 is the same energy with
 // the label similarity factor in E_sim.
@@ -20,6 +23,9 @@ struct EnergyWeights {
   double collision = 1.0;   // w_c, Sec. 4.1
   double limits = 0.2;      // w_l, Sec. 4.1
   double smoothness = 1.0;  // w_s, Sec. 4.1
+  // w_h of E_hand: ours (issue 14), the paper tracks one hand. 1.0 weighs an overlap with the other
+  // hand as much as the same overlap between two fingers of this hand (w_c).
+  double inter_hand = 1.0;
   // R_i, Sec. 4.3: radius of influence of the label similarity factor.
   double label_radius_mm = 200.0;
   // E_smo mixes units; the paper's w_s = 1 balances it in SI units (metres and radians), so
@@ -74,6 +80,61 @@ class CollisionTerm {
   double evaluate_centres(const HandModel& model, const PosedHand& hand, CentreGradients* dE_dcentres) const;
 };
 
+// The other hand, for E_hand: fixed isotropic 3D Gaussians (its posed model) in the camera frame
+// of the hand being fitted, mm. A left hand is fitted as the right hand of the image mirrored about
+// x = 0 (Tracker), so a pose fitted in one hand's frame enters the other's with x negated when
+// exactly one of the two hands is a left hand: assign(..., mirror_x = this_is_left != other_is_left).
+// Storage is reused: no allocation after the first assign() of a model of the same size.
+class HandObstacle {
+ public:
+  // The Gaussians of `hand` (posed `model`), x negated when `mirror_x`.
+  void assign(const HandModel& model, const PosedHand& hand, bool mirror_x);
+  void clear();
+
+  [[nodiscard]] bool empty() const { return x_mm_.empty(); }
+  [[nodiscard]] int size() const { return static_cast<int>(x_mm_.size()); }
+  [[nodiscard]] Eigen::Vector3d centre(int i) const {
+    const auto k = static_cast<size_t>(i);
+    return {x_mm_[k], y_mm_[k], z_mm_[k]};
+  }
+  [[nodiscard]] double sigma_mm(int i) const { return sigma_mm_[static_cast<size_t>(i)]; }
+  // A sphere holding every centre, and the largest sigma: lets E_hand skip far-apart hands.
+  [[nodiscard]] const Eigen::Vector3d& bound_centre_mm() const { return bound_centre_mm_; }
+  [[nodiscard]] double bound_radius_mm() const { return bound_radius_mm_; }
+  [[nodiscard]] double max_sigma_mm() const { return max_sigma_mm_; }
+  // Structure of arrays, for the vectorised pair sums.
+  [[nodiscard]] const double* x_mm() const { return x_mm_.data(); }
+  [[nodiscard]] const double* y_mm() const { return y_mm_.data(); }
+  [[nodiscard]] const double* z_mm() const { return z_mm_.data(); }
+  [[nodiscard]] const double* sigma2_mm2() const { return sigma2_mm2_.data(); }
+
+ private:
+  std::vector<double> x_mm_;
+  std::vector<double> y_mm_;
+  std::vector<double> z_mm_;
+  std::vector<double> sigma_mm_;
+  std::vector<double> sigma2_mm2_;
+  Eigen::Vector3d bound_centre_mm_ = Eigen::Vector3d::Zero();
+  double bound_radius_mm_ = 0.0;
+  double max_sigma_mm_ = 0.0;
+};
+
+// E_hand = 1/E(C_h,C_h) * sum_{p in C_h} sum_{q in other hand} D_pq             (ours, issue 14)
+// with E_col's 3D overlap D_pq (eq. 8) and normalisation (E(C_h,C_h) of this hand at rest), over
+// every pair of one Gaussian of each hand: hands that touch must not interpenetrate. The other
+// hand does not move, so only this hand's centres have a gradient:
+//   dE_hand/dmu_p = -1/E(C_h,C_h) * sum_q D_pq (mu_p - mu_q) / S_pq
+// Pairs with |mu_p - mu_q|^2 / 2S > 30 count 0 (as in E_col), and a model Gaussian whose reach
+// misses the other hand's bounding sphere is skipped whole: hands apart cost ~1 test per Gaussian.
+class InterHandCollisionTerm {
+ public:
+  double evaluate(const HandModel& model, const PosedHand& hand, const HandObstacle& other,
+                  PoseGradient* gradient) const;
+  // E_hand, adding dE_hand/d centre of each model Gaussian into *dE_dcentres when not null.
+  double evaluate_centres(const HandModel& model, const PosedHand& hand, const HandObstacle& other,
+                          CentreGradients* dE_dcentres) const;
+};
+
 // E_lim = sum_j (theta_j^l - theta_j)^2 below the limit, (theta_j - theta_j^h)^2 above   (eq. 9)
 class JointLimitTerm {
  public:
@@ -98,6 +159,7 @@ struct EnergyBreakdown {
   double collision = 0.0;
   double limits = 0.0;
   double smoothness = 0.0;
+  double inter_hand = 0.0;  // E_hand; 0 without EnergyFrame::other_hand
   double total = 0.0;
 };
 
@@ -107,6 +169,7 @@ struct EnergyFrame {
   const DepthInput* input = nullptr;
   const PoseParams* previous = nullptr;         // Theta^{t-1}; E_smo is off when either is null
   const PoseParams* before_previous = nullptr;  // Theta^{t-2}
+  const HandObstacle* other_hand = nullptr;     // E_hand is off when null
 };
 
 class PoseEnergy {
@@ -114,7 +177,8 @@ class PoseEnergy {
   // `label_share`: s of SimilarityFactor::kDepthAndLabel (unused by the other factors).
   PoseEnergy(SimilarityFactor factor, const EnergyWeights& weights, double label_share = 0.5);
 
-  // E(Theta) (eq. 2); adds dE/dTheta into *gradient (which it zeroes first) when not null.
+  // E(Theta) (eq. 2; minus w_h E_hand when frame.other_hand is set); adds dE/dTheta into *gradient
+  // (which it zeroes first) when not null.
   // `hand` is scratch space for the posed model.
   double evaluate(const EnergyFrame& frame, const PoseParams& params, PosedHand& hand, PoseGradient* gradient,
                   EnergyBreakdown* breakdown = nullptr) const;
@@ -128,6 +192,7 @@ class PoseEnergy {
   SimilarityTerm label_similarity_;  // kDepthAndLabel only: the label part of E_sim
   double label_share_;
   CollisionTerm collision_;
+  InterHandCollisionTerm inter_hand_;
   JointLimitTerm limits_;
   SmoothnessTerm smoothness_;
 };
