@@ -18,7 +18,7 @@ constexpr double kClaimMm = 40.0;
 constexpr int kMinClaimSamples = 4;
 // Pixels are sampled every kSampleStridePx (at 320 px width; scaled with the width) to find the
 // claims; the pixels of shared surfaces are each assigned.
-constexpr int kSampleStridePx = 2;
+constexpr int kSampleStridePx = 3;
 // A new surface whose centroid is this near where one was found to be no hand is not tried again
 // (HandsTracker keeps those places for TrackerConfig::new_hand_retry_frames).
 constexpr double kRejectedRadiusMm = 60.0;
@@ -49,15 +49,24 @@ Skeleton::Skeleton(const Joints& joints) {
   for (const auto& j : joints) radius_ = std::max(radius_, (j - centre_).norm());
 }
 
-double Skeleton::distance2(const Vector3d& p) const {
+double Skeleton::bone_distance2(size_t b, const Vector3d& p) const {
   // Nearest point of bone a + t (b - a), t in [0, 1]: t = (p - a).(b - a) / |b - a|^2, clamped.
+  const Vector3d ap = p - from_[b];
+  const double t = std::clamp(ap.dot(along_[b]) * inverse_length2_[b], 0.0, 1.0);
+  return (ap - t * along_[b]).squaredNorm();
+}
+
+double Skeleton::distance2(const Vector3d& p) const {
   double best = std::numeric_limits<double>::infinity();
-  for (size_t b = 0; b < from_.size(); ++b) {
-    const Vector3d ap = p - from_[b];
-    const double t = std::clamp(ap.dot(along_[b]) * inverse_length2_[b], 0.0, 1.0);
-    best = std::min(best, (ap - t * along_[b]).squaredNorm());
-  }
+  for (size_t b = 0; b < from_.size(); ++b) best = std::min(best, bone_distance2(b, p));
   return best;
+}
+
+bool Skeleton::within(const Vector3d& p, double r2) const {
+  for (size_t b = 0; b < from_.size(); ++b) {
+    if (bone_distance2(b, p) < r2) return true;
+  }
+  return false;
 }
 
 void HandSplitter::claim(const DepthInputConfig& config, const CameraIntrinsics& cam, const HandsRequest& request) {
@@ -89,7 +98,7 @@ void HandSplitter::claim(const DepthInputConfig& config, const CameraIntrinsics&
         const Skeleton& sk = skeletons_[static_cast<size_t>(k)];
         const double reach = sk.radius() + kClaimMm;
         if ((p - sk.centre()).squaredNorm() > reach * reach) continue;
-        if (sk.distance2(p) < claim2) ++claims.samples[static_cast<size_t>(s)];
+        if (sk.within(p, claim2)) ++claims.samples[static_cast<size_t>(s)];
       }
     }
   }
@@ -198,12 +207,13 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
     if (share[static_cast<size_t>(s)] != FrameShare::kOwn) continue;
     DepthImage& mine = out[static_cast<size_t>(s)];
     mine.camera = cam;
-    mine.depth_mm.assign(n, 0.0F);
+    mine.depth_mm.resize(n);
     const int fresh = new_surface[static_cast<size_t>(s)];
     for (int v = 0; v < h; ++v) {
       for (int u = 0; u < w; ++u) {
         const auto i = static_cast<size_t>(v) * w + u;
         const int c = component_[i];
+        mine.depth_mm[i] = 0.0F;
         if (c < 0) continue;
         const int owner = owner_[static_cast<size_t>(c)];
         bool keep = fresh >= 0 ? c == fresh : owner == s;

@@ -24,12 +24,15 @@ class Skeleton {
   explicit Skeleton(const Joints& joints);
   // Squared distance (mm^2) of p to the nearest bone.
   [[nodiscard]] double distance2(const Eigen::Vector3d& p) const;
+  // Whether some bone is nearer to p than sqrt(r2) (stops at the first).
+  [[nodiscard]] bool within(const Eigen::Vector3d& p, double r2) const;
   // A sphere around all joints.
   [[nodiscard]] const Eigen::Vector3d& centre() const { return centre_; }
   [[nodiscard]] double radius() const { return radius_; }
 
  private:
   static constexpr int kBones = 4 * kNumFingers;
+  [[nodiscard]] double bone_distance2(size_t bone, const Eigen::Vector3d& p) const;
   std::array<Eigen::Vector3d, kBones> from_{};
   std::array<Eigen::Vector3d, kBones> along_{};  // bone vector
   std::array<double, kBones> inverse_length2_{};

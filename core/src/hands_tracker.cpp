@@ -53,6 +53,7 @@ void HandsTracker::reset() {
     s.last = TrackerOutput{};
     s.current = TrackerOutput{};
     s.id = 0;
+    s.hidden_frames = 0;
   }
   rejected_count_ = 0;
 }
@@ -81,7 +82,28 @@ uint32_t HandsTracker::begin(const HandsInputs& inputs) {
     slot.trying = slot.id == 0 ? inputs.candidate(s) : std::nullopt;
     if (inputs.has(s)) fitting_ |= 1U << static_cast<unsigned>(s);
   }
+  place_obstacles();
   return fitting_;
+}
+
+void HandsTracker::place_obstacles() {
+  for (int s = 0; s < max_hands_; ++s) {
+    Slot& slot = slots_[static_cast<size_t>(s)];
+    slot.tracker.set_other_hand(nullptr, nullptr);
+    if ((fitting_ & (1U << static_cast<unsigned>(s))) == 0) continue;
+    for (int o = 0; o < max_hands_; ++o) {
+      const Slot& other = slots_[static_cast<size_t>(o)];
+      if (o == s || other.id == 0 || other.hidden_frames > 0) continue;  // a hidden hand's pose is old
+      // The other hand's last params are the right-hand model's, in the mirrored image for a left
+      // hand: posed as they are, its Gaussians are in the camera frame after mirroring x exactly
+      // when it is a left hand; a left-hand tracker of this slot wants them mirrored once more.
+      posed_.update(other.tracker.model(), other.last.params);
+      const bool other_left = other.last.handedness == Handedness::kLeft;
+      slot.other[0].assign(other.tracker.model(), posed_, other_left);
+      slot.other[1].assign(other.tracker.model(), posed_, !other_left);
+      slot.tracker.set_other_hand(&slot.other[0], &slot.other[1]);
+    }
+  }
 }
 
 void HandsTracker::fit(int s, const HandsInputs& inputs) {
@@ -105,15 +127,18 @@ HandsOutput HandsTracker::finish() {
     Slot& slot = slots_[static_cast<size_t>(s)];
     if ((fitting_ & (1U << static_cast<unsigned>(s))) == 0) continue;
     if (slot.current.state == TrackingState::kNoHand) {
+      if (slot.id != 0 && ++slot.hidden_frames <= config_.hidden_hand_frames) continue;  // hidden: keeps its id
       // Gone (or never a hand): the slot is free and its id retired.
       if (slot.trying && rejected_count_ < static_cast<int>(rejected_.size())) {
         rejected_[static_cast<size_t>(rejected_count_++)] = {*slot.trying, config_.new_hand_retry_frames};
       }
       slot.id = 0;
+      slot.hidden_frames = 0;
       slot.tracker.reset();
       slot.last = TrackerOutput{};
       continue;
     }
+    slot.hidden_frames = 0;
     if (slot.id == 0) slot.id = ++last_id_;
     slot.current.hand_id = slot.id;
     slot.last = slot.current;

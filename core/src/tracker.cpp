@@ -411,7 +411,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     return none;
   };
   if (!input.has_hand()) return no_hand();
-  EnergyFrame frame{&model_, &input, nullptr, nullptr};
+  EnergyFrame frame{&model_, &input, nullptr, nullptr, other_hand_};
   OptimizerResult best{PoseParams::Zero(), -1e300};
   int winner = -1;
   bool guided_won = false;
@@ -503,7 +503,7 @@ PoseTracker::Fit PoseTracker::restart(const DepthInput& input) {
   // Successive halving: every hypothesis gets kScreenIterations, then only the kRefinedStarts best
   // (by fit score) get the rest of init_iterations. All hypotheses to the end cost 24-48 x 80
   // iterations, 40-100 ms on one frame at every start and suspect-fit check.
-  const EnergyFrame frame{&model_, &input, nullptr, nullptr};
+  const EnergyFrame frame{&model_, &input, nullptr, nullptr, other_hand_};
   const PoseEnergy& energy = fuses(input) ? guided_energy_ : energy_;
   const bool out_of_plane = std::abs(input.finger_axis.z()) >= kOutOfPlaneAxisMinZ;
   const auto fit = [&](const PoseParams& from, int iterations, const PoseEnergy& with) {

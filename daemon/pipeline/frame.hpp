@@ -6,7 +6,7 @@
 // Thread roles: a Frame belongs to exactly one stage at a time; handing its pointer through a
 // FrameQueue hands over the whole entry (the queue's push/pop order the accesses).
 #include "handtrack/core/depth_input.hpp"
-#include "handtrack/core/tracker.hpp"
+#include "handtrack/core/hands_tracker.hpp"
 #include "handtrack/daemon/depth_source.hpp"
 
 #include <boost/lockfree/spsc_queue.hpp>
@@ -18,13 +18,13 @@ namespace handtrack::daemon {
 struct Frame {
   RawFrame raw;
   DepthImage depth;                    // mm
-  TrackerInputs inputs;                // per frame: frame t+1 is preprocessed while t is optimized
+  HandsInputs inputs;                  // per frame: frame t+1 is preprocessed while t is optimized
   uint64_t inputs_generation = 0;      // the TrackerReload generation `inputs` was made for
   bool has_input = false;              // false: no depth in the working volume, or malformed
   bool empty = false;                  // nothing in the working volume: published as no_hand
   bool malformed = false;              // buffer does not match its intrinsics: skipped
   bool resolution_changed = false;     // first frame of a new resolution: the tracker restarts
-  TrackerOutput output;
+  HandsOutput output;
   HandScale scale;
   uint64_t seq = 0;                    // daemon frame number (FrameRecord::frame)
   int64_t capture_ns = 0;

@@ -5,10 +5,17 @@
 
 namespace handtrack::daemon {
 
+namespace {
+constexpr uint32_t bit(int slot) { return 1U << static_cast<unsigned>(slot); }
+}  // namespace
+
 OptimizeStage::OptimizeStage(const TrackerConfig& config, TrackerReload& reload, RequestMailbox& request,
-                             StageWatch& watch)
+                             StageWatch& watch, bool side, std::function<void()> side_setup)
     : reload_(reload), request_(request), watch_(watch) {
   tracker_.emplace(config);
+  request_.put(tracker_->request());  // the first frames: every hand slot free, up to max_hands
+  fit_side_ = [this] { tracker_->fit(1, *side_inputs_); };
+  if (side) side_ = std::make_unique<SideThread>(std::move(side_setup));
 }
 
 void OptimizeStage::apply_reload() {
@@ -16,8 +23,8 @@ void OptimizeStage::apply_reload() {
     const TrackerConfig c = reload_.config();
     tracker_.emplace(c);  // SIGHUP only: allocates
     tracker_generation_ = g;
-    log().info("tracker parameters reloaded ({} particles x {} iterations); tracking restarts", c.particles,
-               c.optimizer.iterations);
+    log().info("tracker parameters reloaded ({} particles x {} iterations, up to {} hands); tracking restarts",
+               c.particles, c.optimizer.iterations, tracker_->max_hands());
   }
 }
 
@@ -27,13 +34,23 @@ void OptimizeStage::step(Frame& f) {
   apply_reload();
   if (f.resolution_changed) tracker_->reset();
   if (f.has_input) {
-    f.output = tracker_->optimise(f.inputs);
+    const uint32_t fitting = tracker_->begin(f.inputs);
+    const bool parallel = side_ != nullptr && (fitting & bit(0)) != 0 && (fitting & bit(1)) != 0;
+    if (parallel) {
+      side_inputs_ = &f.inputs;
+      side_->post(fit_side_);
+    }
+    for (int s = 0; s < kMaxHands; ++s) {
+      if ((fitting & bit(s)) != 0 && !(parallel && s == 1)) tracker_->fit(s, f.inputs);
+    }
+    if (parallel) side_->wait();
+    f.output = tracker_->finish();
   } else {
     tracker_->reset();
-    f.output = TrackerOutput{};
+    f.output = HandsOutput{};
   }
   f.scale = tracker_->config().scale;
-  // What the next frames need (both hands and no hint after a loss: the next frame starts afresh).
+  // What the next frames need (per hand: which of left and right, the hints, the last pose).
   request_.put(tracker_->request());
   f.optimize_end_ns = monotonic_ns();
   watch_.idle(Stage::kOptimize);

@@ -45,32 +45,42 @@ ipc::Handedness to_ipc(Handedness hand) {
   return ipc::Handedness::kUnknown;
 }
 
-void fill_hands(const TrackerOutput& o, const HandScale& scale, float optimize_ms, ipc::FrameRecord& record) {
+void fill_hands(const HandsOutput& output, const HandScale& scale, ipc::FrameRecord& record) {
+  static_assert(kMaxHands <= extent<decltype(ipc::FrameRecord::hands)>, "every hand of a frame has its record");
   for (Hand& h : record.hands) h = Hand{};
-  if (o.state == TrackingState::kNoHand) {
-    record.hand_count = 0;
-    return;
+  record.hand_count = 0;
+  for (int k = 0; k < output.count; ++k) {
+    const TrackerOutput& o = output.hands[static_cast<size_t>(k)];
+    if (o.state == TrackingState::kNoHand) continue;
+    Hand& h = record.hands[record.hand_count++];
+    h.hand_id = o.hand_id;
+    h.handedness = static_cast<int32_t>(to_ipc(o.handedness));
+    h.handedness_confidence = static_cast<float>(o.handedness_confidence);
+    h.state = static_cast<int32_t>(to_ipc(o.state));
+    h.confidence = static_cast<float>(o.confidence);
+    h.energy = static_cast<float>(o.energy);
+    h.optimize_ms = static_cast<float>(output.optimize_ms[static_cast<size_t>(k)]);
+    for (int i = 0; i < kNumPoseParams; ++i) h.params[i] = o.params[i];
+    for (int j = 0; j < kNumJoints; ++j) put(o.joints[static_cast<size_t>(j)], h.joints_mm[j]);
+    for (int t = 0; t < kNumFingers; ++t) put(o.fingertips[static_cast<size_t>(t)], h.fingertips_mm[t]);
+    put(o.palm_centre, h.palm_center_mm);
+    put(o.palm_normal, h.palm_normal);
+    h.pinch_distance_mm = static_cast<float>(o.pinch_distance_mm);
+    h.pinch_strength = static_cast<float>(o.pinch_strength);
+    h.hand_scale[0] = static_cast<float>(scale.length);
+    h.hand_scale[1] = static_cast<float>(scale.width);
+    h.hand_scale[2] = static_cast<float>(scale.sigma);
   }
-  // The tracker follows one hand; a second one (issue 14) becomes hands[1].
-  record.hand_count = 1;
-  Hand& h = record.hands[0];
-  h.hand_id = o.hand_id;
-  h.handedness = static_cast<int32_t>(to_ipc(o.handedness));
-  h.handedness_confidence = static_cast<float>(o.handedness_confidence);
-  h.state = static_cast<int32_t>(to_ipc(o.state));
-  h.confidence = static_cast<float>(o.confidence);
-  h.energy = static_cast<float>(o.energy);
-  h.optimize_ms = optimize_ms;
-  for (int i = 0; i < kNumPoseParams; ++i) h.params[i] = o.params[i];
-  for (int j = 0; j < kNumJoints; ++j) put(o.joints[static_cast<size_t>(j)], h.joints_mm[j]);
-  for (int t = 0; t < kNumFingers; ++t) put(o.fingertips[static_cast<size_t>(t)], h.fingertips_mm[t]);
-  put(o.palm_centre, h.palm_center_mm);
-  put(o.palm_normal, h.palm_normal);
-  h.pinch_distance_mm = static_cast<float>(o.pinch_distance_mm);
-  h.pinch_strength = static_cast<float>(o.pinch_strength);
-  h.hand_scale[0] = static_cast<float>(scale.length);
-  h.hand_scale[1] = static_cast<float>(scale.width);
-  h.hand_scale[2] = static_cast<float>(scale.sigma);
+}
+
+TrackingState frame_state(const HandsOutput& output) {
+  TrackingState state = TrackingState::kNoHand;
+  for (int k = 0; k < output.count; ++k) {
+    const TrackingState s = output.hands[static_cast<size_t>(k)].state;
+    if (s == TrackingState::kTracking) return s;
+    if (s == TrackingState::kRecovering) state = s;
+  }
+  return state;
 }
 
 }  // namespace handtrack::daemon

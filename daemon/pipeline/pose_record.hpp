@@ -3,7 +3,7 @@
 // two vocabularies (core's TrackingState, Handedness and array sizes, the C API's
 // handtrack_tracking_state, handtrack_handedness and HANDTRACK_NUM_*) meet here only;
 // pose_record.cpp static_asserts where they agree and converts where they differ.
-#include "handtrack/core/tracker.hpp"
+#include "handtrack/core/hands_tracker.hpp"
 #include "handtrack/ipc/pose_record.hpp"
 
 namespace handtrack::daemon {
@@ -11,11 +11,14 @@ namespace handtrack::daemon {
 ipc::TrackingState to_ipc(TrackingState state);
 ipc::Handedness to_ipc(Handedness hand);
 
-// Fills the hands of `record` from the tracker's output: hand_count 0 (hands[] zero) when it sees
-// no hand (SPEC.md: "hands" empty), else hand 0 with its id, handedness, state, confidence,
-// energy, params, joints, fingertips, palm, pinch, hand scale and `optimize_ms`. The frame's own
+// Fills the hands of `record` from the tracker's output: hand_count hands (0 and hands[] zero when
+// it sees none: SPEC.md's "hands" empty), each with its id, handedness, state, confidence, energy,
+// params, joints, fingertips, palm, pinch, hand scale and its own optimize time. The frame's own
 // fields (frame number, timings) are the publisher's; epoch and publish_ns the ring writer's.
 // Allocates nothing.
-void fill_hands(const TrackerOutput& output, const HandScale& scale, float optimize_ms, ipc::FrameRecord& record);
+void fill_hands(const HandsOutput& output, const HandScale& scale, ipc::FrameRecord& record);
+// The frame's state for the ring header and the log: tracking when any hand tracks, else
+// recovering when any hand recovers, else no hand.
+TrackingState frame_state(const HandsOutput& output);
 
 }  // namespace handtrack::daemon

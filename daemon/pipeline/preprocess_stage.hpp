@@ -1,7 +1,7 @@
 #pragma once
 // PreprocessStage: raw depth -> C_I (paper Sec. 3.1, 4.3): depth to mm, the working-volume test,
-// then the frame's TrackerInputs for the hands the tracker asked for (median filter, segmentation
-// guided by the last pose's hint, quadtree Gaussians, part labels when a forest is loaded). Frames whose buffer does not match
+// then the frame's HandsInputs for the hands the tracker asked for (the frame shared out among
+// the hands, median filter, segmentation guided by each last pose's hint, quadtree Gaussians, part labels when a forest is loaded). Frames whose buffer does not match
 // their intrinsics are marked malformed (skipped and counted at publish); frames with no depth in
 // the working volume are marked empty (published as no_hand). The first frame of a new resolution
 // is marked so that the optimizer restarts.
@@ -23,7 +23,7 @@ class PreprocessStage {
                   const PartForest* forest, PipelineTally& tally, StageWatch& watch);
 
   // Inputs for a new pool frame, for the configuration in force.
-  [[nodiscard]] TrackerInputs make_inputs() const { return TrackerInputs(input_config_); }
+  [[nodiscard]] HandsInputs make_inputs() const { return HandsInputs(input_config_); }
   void step(Frame& frame);
 
  private:

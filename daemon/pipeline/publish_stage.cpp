@@ -27,20 +27,21 @@ void PublishStage::step(const Frame& f) {
   p.grab_ms = ms_between(f.capture_ns, f.grab_end_ns);
   p.preprocess_ms = ms_between(f.preprocess_start_ns, f.preprocess_end_ns);
   p.optimize_ms = ms_between(f.optimize_start_ns, f.optimize_end_ns);
-  fill_hands(f.output, f.scale, p.optimize_ms, p);  // one hand: its optimization is the frame's
+  fill_hands(f.output, f.scale, p);
   // publish_ms: from the end of optimization to the record going out (hand-over + filling).
   p.publish_ms = ms_between(f.optimize_end_ns, monotonic_ns());
   ring_.publish(p);
   const int64_t end_ns = monotonic_ns();
   tally_.published.fetch_add(1, std::memory_order_relaxed);
   tally_.last_publish_ns.store(end_ns, std::memory_order_relaxed);
-  tally_.tracking_state.store(static_cast<int32_t>(to_ipc(f.output.state)), std::memory_order_relaxed);
+  const TrackingState state = frame_state(f.output);
+  tally_.tracking_state.store(static_cast<int32_t>(to_ipc(state)), std::memory_order_relaxed);
   stats_.add({.grab_ms = p.grab_ms,
               .preprocess_ms = p.preprocess_ms,
               .optimize_ms = p.optimize_ms,
               .publish_ms = ms_between(f.optimize_end_ns, end_ns),
               .latency_ms = ms_between(f.capture_ns, end_ns)});
-  log_state_change(f.output.state, end_ns);
+  log_state_change(state, end_ns);
   watch_.idle(Stage::kPublish);
 }
 

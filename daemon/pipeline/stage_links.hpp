@@ -4,7 +4,7 @@
 // optimize).
 //
 // Thread roles: thread-safe (a mutex each; taken once per frame, never contended for long).
-#include "handtrack/core/tracker.hpp"
+#include "handtrack/core/hands_tracker.hpp"
 
 #include <atomic>
 #include <cstdint>
@@ -13,24 +13,24 @@
 
 namespace handtrack::daemon {
 
-// The tracker's request for the next frame (Tracker::request(): which hands, and the segmentation
-// hints from the last optimized pose): optimize writes after every frame, preprocess reads before
+// The tracker's request for the next frame (HandsTracker::request(): per hand which of left and
+// right, the segmentation hints and the last pose, by which the frame is shared out among the hands): optimize writes after every frame, preprocess reads before
 // every frame. A frame preprocessed while the previous one is still being optimized uses the
 // request of the one before: that lag of one frame is the price of the overlap.
 class RequestMailbox {
  public:
-  void put(const InputRequest& request) {
+  void put(const HandsRequest& request) {
     std::lock_guard lock(mutex_);
     request_ = request;
   }
-  [[nodiscard]] InputRequest get() const {
+  [[nodiscard]] HandsRequest get() const {
     std::lock_guard lock(mutex_);
     return request_;
   }
 
  private:
   mutable std::mutex mutex_;
-  InputRequest request_;
+  HandsRequest request_;
 };
 
 // SIGHUP: the control thread posts a new tracker configuration; each stage that depends on it

@@ -3,6 +3,7 @@
 #include "handtrack/daemon/config.hpp"
 
 #include "handtrack/core/hand_calibration.hpp"
+#include "handtrack/core/hands_tracker.hpp"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -118,6 +119,8 @@ const std::vector<Field>& fields() {
                "auto, left, right"},
      0, 0, "auto | left | right: which hand the tracker fits (auto: both at every (re)start, the better kept)",
      true},
+    {"tracker.max_hands", IntRef{[](DaemonConfig& c) -> int& { return c.tracker.max_hands; }}, 1, kMaxHands,
+     "hands tracked at once (each its own id, handedness and pose; optimized on two cores)", true},
     {"tracker.init_iterations", IntRef{[](DaemonConfig& c) -> int& { return c.tracker.init_iterations; }}, 1, 1000,
      "iterations of each (re)start hypothesis (the best 3 of its 24-48; the others 15)", true},
     {"tracker.lost_confidence", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.lost_confidence; }}, 0, 1,
@@ -177,6 +180,8 @@ const std::vector<Field>& fields() {
      "w_l, weight of the joint-limit term E_lim (Sec. 4.1: 0.2)", true},
     {"tracker.energy.w_s", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.smoothness; }}, 0, 1000,
      "w_s, weight of the smoothness term E_smo (Sec. 4.1: 1.0)", true},
+    {"tracker.energy.w_h", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.inter_hand; }}, 0, 1000,
+     "w_h, weight of the collision term between two hands E_hand (ours: the paper tracks one hand)", true},
     {"tracker.energy.label_radius_mm", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.label_radius_mm; }}, 1, 5000,
      "R_i, radius of influence of the label similarity factor (Sec. 4.3: 200 mm)", true},
     {"tracker.energy.smoothness_translation_per_mm", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.smoothness_translation_per_mm; }}, 0, 1,

@@ -10,7 +10,8 @@ subprocess.run([exe, "--frames", "20", "--json", out], check=True, stdout=subpro
 with open(out) as f:
     table = json.load(f)
 failures = []
-for name in ("depth_only_1p_10it", "depth_only_2p_10it", "late_fusion_2p_10it"):
+TWO_HANDS = ("two_hands_late_fusion_2p_10it", "two_hands_late_fusion_2p_10it_one_thread")
+for name in ("depth_only_1p_10it", "depth_only_2p_10it", "late_fusion_2p_10it", "late_fusion_2p_10it_max_hands_2") + TWO_HANDS:
     entry = table.get(name)
     if entry is None:
         failures.append(f"{name}: missing")
@@ -26,6 +27,14 @@ for name in ("depth_only_1p_10it", "depth_only_2p_10it", "late_fusion_2p_10it"):
         failures.append(f"{name}: resolution {entry.get('width')}x{entry.get('height')}")
 if not failures and (table["depth_only_2p_10it"]["particles"], table["late_fusion_2p_10it"]["particles"]) != (2, 2):
     failures.append("the 2-particle configurations do not run 2 particles")
+# The two-hand configurations track two hands (the scene shows two from its first frame) and say
+# how much of their work overlapped: between 1 (one after the other) and 2 (side by side).
+for name in TWO_HANDS:
+    entry = table.get(name, {})
+    if not 1.5 <= entry.get("hands_per_frame", 0) <= 2:
+        failures.append(f"{name}: {entry.get('hands_per_frame')!r} hands per frame")
+    if not 0.5 <= entry.get("hand_overlap", 0) <= 2.05:
+        failures.append(f"{name}: hand_overlap {entry.get('hand_overlap')!r}")
 for f in failures:
     print("FAIL:", f)
 sys.exit(1 if failures else 0)

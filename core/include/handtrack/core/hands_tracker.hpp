@@ -15,8 +15,10 @@
 //   4. Each slot's Tracker sees a depth image with every pixel but its own removed (0, no
 //      measurement), and fits it exactly as it fits a single hand.
 //
-// A slot whose Tracker reports no hand is freed; its id is never given out again, so a hand that
-// leaves and comes back has a fresh id and a fresh start. Where two hands are fitted the other
+// A slot whose Tracker finds no hand keeps its id and last pose, unreported, for
+// TrackerConfig::hidden_hand_frames frames (a hand hidden behind the other one keeps its id when it
+// shows again near where it was); then it is freed and its id is never given out again, so a hand
+// that leaves and comes back has a fresh id and a fresh start. Where two hands are fitted the other
 // hand's last pose is an obstacle for each (EnergyFrame::other_hand, E_col between the hands).
 //
 // Threading: like Tracker, request() / begin() / finish() on one thread; fit(slot) of different
@@ -24,6 +26,8 @@
 // mutable state: HandsTracker's own state is written only by begin() and finish()).
 // HandsInputs::build() anywhere, on inputs no fit reads at the time.
 
+#include "handtrack/core/energy.hpp"
+#include "handtrack/core/kinematics.hpp"
 #include "handtrack/core/tracker.hpp"
 
 #include <array>
@@ -130,8 +134,14 @@ class HandsTracker {
     TrackerOutput current;   // this frame's, written by fit()
     double optimize_ms = 0.0;
     uint32_t id = 0;         // handtrack's hand id, 0 while free
+    int hidden_frames = 0;   // frames in a row without a fit while holding an id
     std::optional<Eigen::Vector3d> trying;  // a free slot's new surface this frame
+    // The other hand's last pose, as this slot's right-hand tracker sees it and as its left-hand
+    // tracker does (begin()).
+    std::array<HandObstacle, 2> other;
   };
+  // Sets each fitting slot's obstacle: the other hand's last pose, when there is one.
+  void place_obstacles();
   struct Rejected {
     Eigen::Vector3d centre;
     int frames_left = 0;
@@ -144,6 +154,7 @@ class HandsTracker {
   std::array<Rejected, kMaxHands> rejected_{};
   int rejected_count_ = 0;
   HandsInputs inputs_;    // track()'s
+  PosedHand posed_;       // place_obstacles()' scratch
 };
 
 }  // namespace handtrack

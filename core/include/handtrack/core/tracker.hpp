@@ -94,6 +94,9 @@ struct TrackerConfig {
   // A surface that a new hand's (re)start found to be no hand is not tried again for this many
   // frames (HandsTracker).
   int new_hand_retry_frames = 15;
+  // A hand that finds no fit (hidden behind the other hand, or gone) keeps its slot and id, unreported,
+  // for this many frames: where it shows again near its last pose it is the same hand (HandsTracker).
+  int hidden_hand_frames = 20;
   uint64_t seed = 1;
 };
 
@@ -156,6 +159,9 @@ class PoseTracker {
   [[nodiscard]] const HandModel& model() const { return model_; }
   [[nodiscard]] const TrackerConfig& config() const { return config_; }
   void set_scale(const HandScale& scale);
+  // Another hand in the frame, in this tracker's camera frame, that the fit must not enter
+  // (E_hand); null: none. It must outlive the optimise() calls that use it.
+  void set_other_hand(const HandObstacle* other) { other_hand_ = other; }
   // One (re)start hypothesis: Sec. 5's open hand, or a closed one, placed at the segmented hand.
   struct Start {
     double in_plane_offset_rad = 0.0;  // turned about the camera axis away from the segmented axis
@@ -203,6 +209,7 @@ class PoseTracker {
   AdaptiveGradientAscent optimizer_;
   PosedHand scratch_;
   std::vector<Fit> screened_;  // restart()'s hypotheses after their first iterations
+  const HandObstacle* other_hand_ = nullptr;
   std::mt19937_64 rng_;
   std::optional<PoseParams> previous_;
   std::optional<PoseParams> before_previous_;
@@ -275,8 +282,18 @@ class Tracker {
   // mirrored image); the input is null when that hand was not preprocessed.
   [[nodiscard]] const DepthInput* last_input() const { return inputs_.get(current_); }
   [[nodiscard]] PoseTracker& pose_tracker() { return side(current_); }
+  // The hand model (both hands' trackers share its scale; a left hand's is the right-hand model
+  // of the mirrored image).
+  [[nodiscard]] const HandModel& model() const { return right_.model(); }
   [[nodiscard]] const TrackerConfig& config() const { return right_.config(); }
   void reset();
+  // Another hand in the frame that this one must not enter (HandsTracker): its Gaussians as the
+  // right hand's tracker sees them (camera frame) and as the left hand's does (mirrored); null:
+  // none.
+  void set_other_hand(const HandObstacle* as_right, const HandObstacle* as_left) {
+    right_.set_other_hand(as_right);
+    left_.set_other_hand(as_left);
+  }
 
  private:
   [[nodiscard]] const PoseTracker& side(Handedness hand) const { return hand == Handedness::kLeft ? left_ : right_; }
