@@ -144,6 +144,7 @@ HandsOutput HandsTracker::finish() {
     slot.last = slot.current;
     out.hands[static_cast<size_t>(out.count)] = slot.current;
     out.optimize_ms[static_cast<size_t>(out.count)] = slot.optimize_ms;
+    out.slot[static_cast<size_t>(out.count)] = s;
     ++out.count;
   }
   return out;

@@ -105,6 +105,7 @@ struct HandsOutput {
   int count = 0;
   std::array<TrackerOutput, kMaxHands> hands{};
   std::array<double, kMaxHands> optimize_ms{};  // each hand's fit (wall clock of its thread)
+  std::array<int, kMaxHands> slot{};            // each hand's slot (HandsTracker::slot_tracker, HandsInputs::slot)
 };
 
 class HandsTracker {
