@@ -83,6 +83,17 @@ uint32_t HandsTracker::begin(const HandsInputs& inputs) {
     if (inputs.has(s)) fitting_ |= 1U << static_cast<unsigned>(s);
   }
   place_obstacles();
+  // Two hands in one frame are usually a left and a right one: each slot expects to be the hand the
+  // other is not (it decides choices between left and right that its fits leave open).
+  for (int s = 0; s < max_hands_; ++s) {
+    std::optional<Handedness> expected;
+    for (int o = 0; o < max_hands_; ++o) {
+      const Slot& other = slots_[static_cast<size_t>(o)];
+      if (o == s || other.id == 0 || other.hidden_frames > 0) continue;
+      expected = other.last.handedness == Handedness::kLeft ? Handedness::kRight : Handedness::kLeft;
+    }
+    slots_[static_cast<size_t>(s)].tracker.expect(expected);
+  }
   return fitting_;
 }
 
@@ -146,6 +157,11 @@ HandsOutput HandsTracker::finish() {
     out.optimize_ms[static_cast<size_t>(out.count)] = slot.optimize_ms;
     out.slot[static_cast<size_t>(out.count)] = s;
     ++out.count;
+  }
+  // Both hands chosen as the same hand: the less clear choice is made again at the next frame.
+  if (out.count == 2 && out.hands[0].handedness == out.hands[1].handedness) {
+    const int doubtful = out.hands[0].handedness_confidence <= out.hands[1].handedness_confidence ? 0 : 1;
+    slots_[static_cast<size_t>(out.slot[static_cast<size_t>(doubtful)])].tracker.question_handedness();
   }
   return out;
 }

@@ -183,11 +183,15 @@ bool Tracker::prefer(const TrackerOutput& a, const TrackerOutput& b) const {
   // way to the sphere model, and only finger flexion and the thumb's depth tell them apart. When
   // the two explain the hand equally well (within handedness_margin) the palm toward the camera
   // wins, the common view of a desk camera facing the user (docs/TRACKER.md, "Left hands").
+  // With another hand in view (HandsTracker), the hand it is not wins such a tie first: two hands
+  // in one frame are usually a left and a right one.
   const bool a_palm = a.palm_normal.z() < 0.0;
   const bool b_palm = b.palm_normal.z() < 0.0;
   const double a_score = fit_score(a.confidence, a.label_agreement);
   const double b_score = fit_score(b.confidence, b.label_agreement);
-  if (a_palm != b_palm && std::abs(a_score - b_score) < config().handedness_margin) return a_palm;
+  const bool tie = std::abs(a_score - b_score) < config().handedness_margin;
+  if (tie && expected_ && a.handedness != b.handedness) return a.handedness == *expected_;
+  if (tie && a_palm != b_palm) return a_palm;
   return a_score > b_score;
 }
 

@@ -294,6 +294,16 @@ class Tracker {
     right_.set_other_hand(as_right);
     left_.set_other_hand(as_left);
   }
+  // Which hand this one probably is (HandsTracker: not the other hand in view), for choices within
+  // handedness_margin; nullopt: no expectation.
+  void expect(std::optional<Handedness> hand) { expected_ = hand; }
+  // Fit both hands again at the next frame (HandsTracker: both hands in view were chosen as the
+  // same hand).
+  void question_handedness() {
+    settled_ = false;
+    frames_since_hand_check_ = config().handedness_check_frames;
+  }
+  [[nodiscard]] Handedness current_hand() const { return current_; }
 
  private:
   [[nodiscard]] const PoseTracker& side(Handedness hand) const { return hand == Handedness::kLeft ? left_ : right_; }
@@ -311,6 +321,7 @@ class Tracker {
   Handedness current_ = Handedness::kRight;
   double handedness_confidence_ = 1.0;
   bool settled_ = true;                // the last choice of hand was clear (handedness_margin)
+  std::optional<Handedness> expected_;  // expect()
   int frames_since_hand_check_ = 0;
   bool tracking_ = false;  // the current hand tracked in the last frame
   uint32_t hand_id_ = 0;   // of the hand in view; 0: none in the last frame
