@@ -59,9 +59,11 @@ std::optional<double> parse_cell(const std::string& cell, const fs::path& file, 
 // Frame numbers are ints written as NNNNNN (SPEC.md); the largest a file name or CSV row may hold.
 constexpr int kMaxFrameNumber = 999'999'999;
 
-// Reads a CSV whose rows are: frame, then `values` numbers (possibly empty). Calls row(frame, cells).
+// Reads a CSV whose rows are: frame, then `per_hand` numbers (possibly empty) for each of `hands`
+// hands. Calls row(frame, cells).
 template <typename RowFn>
-void read_csv(const fs::path& file, size_t values, RowFn&& row) {
+void read_csv(const fs::path& file, size_t per_hand, size_t hands, RowFn&& row) {
+  const size_t values = per_hand * hands;
   std::ifstream in(file);
   if (!in) fail(file, "cannot open");
   std::string line;
@@ -72,8 +74,15 @@ void read_csv(const fs::path& file, size_t values, RowFn&& row) {
     auto cells = split_csv(line);
     if (n == 1 && !cells.empty() && cells[0] == "frame") continue;  // header
     if (cells.size() != values + 1) {
-      fail(file, "line " + std::to_string(n) + ": expected " + std::to_string(values + 1) + " cells, found " +
-                     std::to_string(cells.size()));
+      std::string why = "line " + std::to_string(n) + ": expected " + std::to_string(values + 1) + " cells, found " +
+                        std::to_string(cells.size());
+      if (hands > 1) {
+        why += " (the frame, then " + std::to_string(per_hand) + " per hand for the " + std::to_string(hands) +
+               " hands hand.json names)";
+      } else if (cells.size() > 1 && (cells.size() - 1) % per_hand == 0) {
+        why += " (" + std::to_string((cells.size() - 1) / per_hand) + " hands' columns: hand.json must name them)";
+      }
+      fail(file, why);
     }
     const auto frame = parse_cell(cells[0], file, n);
     if (!frame || *frame < 0 || *frame > kMaxFrameNumber || *frame != std::floor(*frame)) {
@@ -86,15 +95,29 @@ void read_csv(const fs::path& file, size_t values, RowFn&& row) {
   }
 }
 
-std::string header(bool joints) {
+std::string header(bool joints, int hands) {
   std::string h = "frame";
   const int count = joints ? kNumJoints : kNumFingers;
-  for (int i = 0; i < count; ++i) {
-    const std::string stem(joints ? joint_name(i) : kFingerNames[static_cast<size_t>(i)]);
-    for (const char* axis : {"_x", "_y", "_z"}) h += "," + stem + axis;
+  for (int hand = 0; hand < hands; ++hand) {
+    for (int i = 0; i < count; ++i) {
+      const std::string stem = hand_column_prefix(hand) +
+                               std::string(joints ? joint_name(i) : kFingerNames[static_cast<size_t>(i)]);
+      for (const char* axis : {"_x", "_y", "_z"}) h += "," + stem + axis;
+    }
   }
   return h;
 }
+
+// Cells first..first + 2 as a point, if all three are given.
+std::optional<Eigen::Vector3d> point(const std::vector<std::optional<double>>& v, size_t first) {
+  if (!v[first] || !v[first + 1] || !v[first + 2]) return std::nullopt;
+  return Eigen::Vector3d(*v[first], *v[first + 1], *v[first + 2]);
+}
+
+constexpr size_t kTipValues = 3 * kNumFingers;  // per hand in groundtruth.csv
+constexpr size_t kJointValues = 3 * kNumJoints;  // per hand in joints.csv
+
+bool valid_hand_name(const std::string& name) { return name == "right" || name == "left"; }
 
 void write_vec(std::ostream& out, const Eigen::Vector3d& v) {
   char buf[96];
@@ -138,6 +161,46 @@ CameraIntrinsics read_camera_json(const fs::path& file) {
   return c;
 }
 
+std::string hand_column_prefix(int hand) {
+  if (hand == 0) return {};
+  // Appended piecewise: gcc 12's -Wrestrict misfires on "h" + std::to_string(hand) + "_".
+  std::string prefix = "h";
+  prefix += std::to_string(hand);
+  prefix += '_';
+  return prefix;
+}
+
+std::vector<std::string> read_hand_json(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) fail(file, "cannot open");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    fail(file, std::string("not valid JSON: ") + e.what());
+  }
+  const std::string expected = "field 'hands' must list 1 to " + std::to_string(kMaxSequenceHands) +
+                               " of \"right\" and \"left\", e.g. {\"hands\":[\"right\",\"left\"]}";
+  if (!j.is_object() || !j.contains("hands")) fail(file, "missing " + expected);
+  const auto& list = j["hands"];
+  if (!list.is_array() || list.empty() || list.size() > static_cast<size_t>(kMaxSequenceHands)) fail(file, expected);
+  std::vector<std::string> hands;
+  for (const auto& h : list) {
+    if (!h.is_string() || !valid_hand_name(h.get<std::string>())) fail(file, expected);
+    hands.push_back(h.get<std::string>());
+  }
+  return hands;
+}
+
+void write_hand_json(const fs::path& file, const std::vector<std::string>& hands,
+                     const std::vector<std::pair<std::string, std::string>>& extra) {
+  nlohmann::json j = {{"hands", hands}};
+  for (const auto& [key, value] : extra) j[key] = value;
+  std::ofstream out(file);
+  if (!out) fail(file, "cannot write");
+  out << j.dump() << "\n";
+}
+
 void write_camera_json(const fs::path& file, const CameraIntrinsics& c) {
   nlohmann::json j = {{"width", c.width}, {"height", c.height}, {"fx", c.fx},
                       {"fy", c.fy},       {"cx", c.cx},         {"cy", c.cy},
@@ -169,26 +232,47 @@ SequenceReader::SequenceReader(fs::path dir, Annotations annotations) : dir_(std
   if (frames_.empty()) fail(depth_dir, "holds no NNNNNN.png frames");
   if (annotations == Annotations::kIgnore) return;
 
+  if (const auto hj = dir_ / "hand.json"; fs::exists(hj)) hands_ = read_hand_json(hj);
+  const auto hands = static_cast<size_t>(hand_count());
   if (const auto gt = dir_ / "groundtruth.csv"; fs::exists(gt)) {
-    read_csv(gt, 3 * kNumFingers, [&](int frame, const std::vector<std::optional<double>>& v) {
-      Fingertips tips;
-      for (int f = 0; f < kNumFingers; ++f) {
-        const auto i = static_cast<size_t>(3 * f);
-        if (v[i] && v[i + 1] && v[i + 2]) tips[static_cast<size_t>(f)] = Eigen::Vector3d(*v[i], *v[i + 1], *v[i + 2]);
+    read_csv(gt, kTipValues, hands, [&](int frame, const std::vector<std::optional<double>>& v) {
+      std::vector<Fingertips> per_hand(hands);
+      for (size_t h = 0; h < hands; ++h) {
+        for (size_t f = 0; f < kNumFingers; ++f) per_hand[h][f] = point(v, h * kTipValues + 3 * f);
       }
-      groundtruth_[frame] = tips;
+      groundtruth_[frame] = std::move(per_hand);
     });
   }
   if (const auto jf = dir_ / "joints.csv"; fs::exists(jf)) {
-    read_csv(jf, 3 * kNumJoints, [&](int frame, const std::vector<std::optional<double>>& v) {
-      Joints joints;
-      for (size_t k = 0; k < kNumJoints; ++k) {
-        if (!v[3 * k] || !v[3 * k + 1] || !v[3 * k + 2]) fail(jf, "frame " + std::to_string(frame) + ": empty cell");
-        joints[k] = Eigen::Vector3d(*v[3 * k], *v[3 * k + 1], *v[3 * k + 2]);
+    read_csv(jf, kJointValues, hands, [&](int frame, const std::vector<std::optional<double>>& v) {
+      std::vector<std::optional<Joints>> per_hand(hands);
+      for (size_t h = 0; h < hands; ++h) {
+        const size_t first = h * kJointValues;
+        // A hand's block all empty: not annotated in this frame; partly empty: an error.
+        if (std::none_of(v.begin() + static_cast<std::ptrdiff_t>(first),
+                         v.begin() + static_cast<std::ptrdiff_t>(first + kJointValues),
+                         [](const std::optional<double>& c) { return c.has_value(); })) {
+          continue;
+        }
+        Joints joints;
+        for (size_t k = 0; k < kNumJoints; ++k) {
+          const auto p = point(v, first + 3 * k);
+          if (!p) fail(jf, "frame " + std::to_string(frame) + ": empty cell");
+          joints[k] = *p;
+        }
+        per_hand[h] = joints;
       }
-      joints_[frame] = joints;
+      joints_[frame] = std::move(per_hand);
     });
   }
+}
+
+size_t SequenceReader::hand_slot(int hand) const {
+  if (hand < 0 || hand >= hand_count()) {
+    throw std::out_of_range(dir_.string() + ": no hand " + std::to_string(hand) + " (the sequence has " +
+                            std::to_string(hand_count()) + ")");
+  }
+  return static_cast<size_t>(hand);
 }
 
 DepthImage SequenceReader::depth(size_t i) const {
@@ -203,15 +287,17 @@ std::optional<Gray8Image> SequenceReader::labels(size_t i) const {
   return read_png_gray8(file, PngSize{camera_.width, camera_.height});
 }
 
-Fingertips SequenceReader::fingertips(size_t i) const {
+Fingertips SequenceReader::fingertips(size_t i, int hand) const {
+  const size_t h = hand_slot(hand);
   const auto it = groundtruth_.find(frames_.at(i));
-  return it == groundtruth_.end() ? Fingertips{} : it->second;
+  return it == groundtruth_.end() ? Fingertips{} : it->second[h];
 }
 
-std::optional<Joints> SequenceReader::joints(size_t i) const {
+std::optional<Joints> SequenceReader::joints(size_t i, int hand) const {
+  const size_t h = hand_slot(hand);
   const auto it = joints_.find(frames_.at(i));
   if (it == joints_.end()) return std::nullopt;
-  return it->second;
+  return it->second[h];
 }
 
 SequenceWriter::SequenceWriter(fs::path dir, const CameraIntrinsics& camera) : dir_(std::move(dir)), camera_(camera) {
@@ -241,19 +327,56 @@ void SequenceWriter::write_labels(int frame, const Gray8Image& labels) {
   write_png_gray8(frame_file(dir_ / "labels", frame), labels);
 }
 
-void SequenceWriter::write_fingertips(int frame, const Fingertips& tips) { groundtruth_[frame] = tips; }
-void SequenceWriter::write_joints(int frame, const Joints& joints) { joints_[frame] = joints; }
+void SequenceWriter::write_hands(const std::vector<std::string>& hands,
+                                 const std::vector<std::pair<std::string, std::string>>& extra) {
+  if (hands.empty() || hands.size() > static_cast<size_t>(kMaxSequenceHands) ||
+      !std::all_of(hands.begin(), hands.end(), valid_hand_name)) {
+    throw std::invalid_argument("a sequence shows 1 to " + std::to_string(kMaxSequenceHands) +
+                                " hands, each \"right\" or \"left\"");
+  }
+  if (static_cast<int>(hands.size()) < hand_count_) {
+    throw std::invalid_argument("ground truth of " + std::to_string(hand_count_) + " hands was written already");
+  }
+  hand_count_ = static_cast<int>(hands.size());
+  write_hand_json(dir_ / "hand.json", hands, extra);
+}
+
+size_t SequenceWriter::hand_slot(int hand) const {
+  if (hand < 0 || hand >= hand_count_) {
+    throw std::out_of_range(dir_.string() + ": no hand " + std::to_string(hand) + " (write_hands() names " +
+                            std::to_string(hand_count_) + ")");
+  }
+  return static_cast<size_t>(hand);
+}
+
+void SequenceWriter::write_fingertips(int frame, const Fingertips& tips, int hand) {
+  const size_t h = hand_slot(hand);
+  auto& row = groundtruth_[frame];
+  row.resize(static_cast<size_t>(kMaxSequenceHands));
+  row[h] = tips;
+}
+
+void SequenceWriter::write_joints(int frame, const Joints& joints, int hand) {
+  const size_t h = hand_slot(hand);
+  auto& row = joints_[frame];
+  row.resize(static_cast<size_t>(kMaxSequenceHands));
+  row[h] = joints;
+}
 
 void SequenceWriter::flush() {
+  // One block per hand in each row; a hand without ground truth in a frame gets empty cells.
+  const auto hands = static_cast<size_t>(hand_count_);
   if (!groundtruth_.empty()) {
     std::ofstream out(dir_ / "groundtruth.csv");
     if (!out) fail(dir_ / "groundtruth.csv", "cannot write");
-    out << header(false) << "\n";
-    for (const auto& [frame, tips] : groundtruth_) {
+    out << header(false, hand_count_) << "\n";
+    for (const auto& [frame, per_hand] : groundtruth_) {
       out << frame;
-      for (const auto& tip : tips) {
-        if (tip) write_vec(out, *tip);
-        else out << ",,,";
+      for (size_t h = 0; h < hands; ++h) {
+        for (const auto& tip : per_hand[h].value_or(Fingertips{})) {
+          if (tip) write_vec(out, *tip);
+          else out << ",,,";
+        }
       }
       out << "\n";
     }
@@ -261,10 +384,16 @@ void SequenceWriter::flush() {
   if (!joints_.empty()) {
     std::ofstream out(dir_ / "joints.csv");
     if (!out) fail(dir_ / "joints.csv", "cannot write");
-    out << header(true) << "\n";
-    for (const auto& [frame, joints] : joints_) {
+    out << header(true, hand_count_) << "\n";
+    for (const auto& [frame, per_hand] : joints_) {
       out << frame;
-      for (const auto& j : joints) write_vec(out, j);
+      for (size_t h = 0; h < hands; ++h) {
+        if (per_hand[h]) {
+          for (const auto& j : *per_hand[h]) write_vec(out, j);
+        } else {
+          for (int k = 0; k < kNumJoints; ++k) out << ",,,";
+        }
+      }
       out << "\n";
     }
   }

@@ -200,4 +200,22 @@ void posed_primitives(const HandShape& shape, const HandPose& pose, const Joints
   out.push_back(to_camera(shape.forearm));
 }
 
+void place_palm(HandPose& pose, const HandShape& shape, const Eigen::Matrix3d& turn, const Vector3d& palm_centre_mm) {
+  const Eigen::AngleAxisd aa(turn);
+  pose.rotation = aa.angle() * aa.axis();
+  // Palm centre c = t + R palm_centre (hand frame) => t = c - R palm_centre.
+  pose.translation_mm = palm_centre_mm - camera_R_hand(pose.rotation) * shape.palm_centre_mm;
+}
+
+void mirror_x(Joints& joints) {
+  for (auto& j : joints) j.x() = -j.x();
+}
+
+void mirror_x(std::vector<ConeSphere>& solids) {
+  for (auto& c : solids) {
+    c.a.x() = -c.a.x();
+    c.b.x() = -c.b.x();
+  }
+}
+
 }  // namespace handtrack::synth

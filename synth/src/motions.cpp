@@ -217,27 +217,30 @@ Motion::Motion(std::string_view name, int frames, double fps, const HandShape& s
   if (index_ == 4) pinch_ = solve_pinch(shape_, limits_);
 }
 
-double Motion::motion_time(int frame) const {
+double Motion::motion_time(int frame) const { return warped_motion_time(frame, frames_, fps_); }
+
+double warped_motion_time(int frame, int frames, double fps) {
   frame = std::max(frame, 0);
   // Play back and forth beyond the end: frames 0..N-1, N-2..1, 0..N-1, ...
-  if (frames_ > 1 && frame >= frames_) {
-    const int period = 2 * (frames_ - 1);
+  if (frames > 1 && frame >= frames) {
+    const int period = 2 * (frames - 1);
     const int k = frame % period;
-    frame = k < frames_ ? k : period - k;
-  } else if (frames_ == 1) {
+    frame = k < frames ? k : period - k;
+  } else if (frames == 1) {
     frame = 0;
   }
   // Speed 1 in the first half, kFastSpeedFactor in the second, smoothstep ramp of
   // kSpeedRampSeconds centred on the midpoint; tau = integral of the speed.
-  const double t = frame / fps_;
-  const double mid = 0.5 * frames_ / fps_;
+  const double t = frame / fps;
+  const double mid = 0.5 * frames / fps;
   const double w = kSpeedRampSeconds;
   const auto x = [&](double time) { return (time - (mid - 0.5 * w)) / w; };
   return t + (kFastSpeedFactor - 1.0) * w * (smoothstep_integral(x(t)) - smoothstep_integral(x(0.0)));
 }
 
-HandPose Motion::pose(int frame) const {
-  const double tau = motion_time(frame);
+HandPose Motion::pose(int frame) const { return pose_at(motion_time(frame)); }
+
+HandPose Motion::pose_at(double tau) const {
   const double phase = tau / kCycleSeconds[static_cast<size_t>(index_)];
   HandAngles angles = kOpen;
   Global global = gentle_sway(tau);
@@ -289,10 +292,7 @@ HandPose Motion::pose(int frame) const {
                                  Eigen::AngleAxisd(global.euler_rad.y(), Vector3d::UnitY()) *
                                  Eigen::AngleAxisd(global.euler_rad.x(), Vector3d::UnitX()))
                                     .toRotationMatrix();
-  const Eigen::AngleAxisd aa(delta);
-  pose.rotation = aa.angle() * aa.axis();
-  // Rotate about the palm centre: t = c - R palm_centre.
-  pose.translation_mm = global.palm_centre_mm - camera_R_hand(pose.rotation) * shape_.palm_centre_mm;
+  place_palm(pose, shape_, delta, global.palm_centre_mm);  // rotates about the palm centre
   return limits_.clamp(pose);
 }
 

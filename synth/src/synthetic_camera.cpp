@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -17,6 +18,12 @@ using Eigen::Vector3d;
 constexpr uint64_t kSubjectStream = 0x5B1EC7;
 constexpr uint64_t kNoiseStream = 0x0015E;
 constexpr double kSubjectSpread = 0.10;  // random subjects: scales within +-10 % (module brief)
+// Two-hand scenes draw both hands into one z-buffer with hand k's solids labelled
+// part_label | (k + 1) << kHandTagShift, so that each pixel says which hand it shows; the tag is
+// split off into SynthFrame::hand_index afterwards.
+constexpr int kHandTagShift = 4;
+static_assert(kNumPartLabels < (1 << kHandTagShift), "the part labels must fit below the hand tag");
+static_assert(kTwoHands << kHandTagShift <= 0xFF, "the tagged labels must fit a label byte");
 
 PlanePatch make_patch(const Vector3d& origin, const Vector3d& normal, double half_u, double half_v) {
   PlanePatch p;
@@ -79,7 +86,7 @@ void mirror(SynthFrame& f) {
     std::reverse(f.depth.depth_mm.begin() + row, f.depth.depth_mm.begin() + row + w);
     std::reverse(f.labels.pixels.begin() + row, f.labels.pixels.begin() + row + w);
   }
-  for (auto& j : f.joints) j.x() = -j.x();
+  mirror_x(f.joints);
   for (auto& t : f.fingertips) {
     if (t) t->x() = -t->x();
   }
@@ -102,38 +109,57 @@ CameraIntrinsics default_camera(int width, int height) {
 
 struct SyntheticCamera::State {
   SynthOptions options;
-  HandShape shape;
-  Motion motion;
+  std::array<HandShape, kTwoHands> shapes;  // [1]: two-hand motions only
+  std::optional<Motion> motion;             // a one-hand motion
+  std::optional<TwoHandMotion> two_hands;   // or a two-hand scene
   Raycaster raycaster;
   std::vector<ConeSphere> primitives;
   // The static scene, drawn once; each frame starts from a copy of it and draws the hand (a
   // z-buffer does not care about the order).
   Raycaster background;
 
-  State(SynthOptions o, const HandShape& s)
-      : options(std::move(o)), shape(s), motion(options.motion, options.frames, options.camera.fps, shape),
-        raycaster(render_camera(options)), background(render_camera(options)) {}
+  State(SynthOptions o, const std::array<HandShape, kTwoHands>& s)
+      : options(std::move(o)), shapes(s), raycaster(render_camera(options)), background(render_camera(options)) {
+    if (is_two_hand_motion(options.motion)) {
+      two_hands.emplace(options.motion, options.frames, options.camera.fps, shapes);
+    } else {
+      motion.emplace(options.motion, options.frames, options.camera.fps, shapes[0]);
+    }
+  }
 
+  // The raycaster's scene into out.depth and out.labels: with the noise model, or clean within range.
+  void develop(int frame, SynthFrame& out) const;
   void apply_noise(int frame, SynthFrame& out) const;
+  void render_two_hands(int frame, SynthFrame& out);
 };
 
 SyntheticCamera::SyntheticCamera(SynthOptions options) {
   if (auto why = options.camera.problem(); !why.empty()) throw std::invalid_argument("camera: " + why);
-  SubjectScale subject;
-  if (options.subject) {
-    subject = *options.subject;
-    const auto ok = [](double s) { return std::isfinite(s) && s >= 0.5 && s <= 2.0; };
-    if (!ok(subject.length) || !ok(subject.width)) {
-      throw std::invalid_argument("subject scale must be within [0.5, 2], got " + std::to_string(subject.length) +
-                                  "," + std::to_string(subject.width));
-    }
-  } else {
-    Rng rng = Rng::stream(options.seed, kSubjectStream);
-    subject.length = rng.uniform(1.0 - kSubjectSpread, 1.0 + kSubjectSpread);
-    subject.width = rng.uniform(1.0 - kSubjectSpread, 1.0 + kSubjectSpread);
-    options.subject = subject;
+  if (is_two_hand_motion(options.motion) && (options.hand != Handedness::kRight || options.view != View::kPalm)) {
+    throw std::invalid_argument("motion '" + options.motion +
+                                "' shows a right and a left hand in its own arrangement: no hand or view to choose");
   }
-  state_ = std::make_unique<State>(std::move(options), HandShape::for_subject(subject));
+  std::array<SubjectScale, kTwoHands> subjects;
+  if (options.subject) {
+    const auto ok = [](double s) { return std::isfinite(s) && s >= 0.5 && s <= 2.0; };
+    if (!ok(options.subject->length) || !ok(options.subject->width)) {
+      throw std::invalid_argument("subject scale must be within [0.5, 2], got " +
+                                  std::to_string(options.subject->length) + "," +
+                                  std::to_string(options.subject->width));
+    }
+    subjects.fill(*options.subject);
+  } else {
+    // Hand k from its own stream; hand 0's is the one-hand motions' subject of that seed.
+    for (size_t k = 0; k < kTwoHands; ++k) {
+      Rng rng = Rng::stream(options.seed, kSubjectStream, k);
+      subjects[k].length = rng.uniform(1.0 - kSubjectSpread, 1.0 + kSubjectSpread);
+      subjects[k].width = rng.uniform(1.0 - kSubjectSpread, 1.0 + kSubjectSpread);
+    }
+    options.subject = subjects[0];
+  }
+  state_ = std::make_unique<State>(std::move(options), std::array<HandShape, kTwoHands>{
+                                                           HandShape::for_subject(subjects[0]),
+                                                           HandShape::for_subject(subjects[1])});
   State& s = *state_;
   std::vector<PlanePatch> planes;
   std::vector<ConeSphere> background_solids;
@@ -162,13 +188,20 @@ SyntheticCamera::~SyntheticCamera() = default;
 SyntheticCamera::SyntheticCamera(SyntheticCamera&&) noexcept = default;
 SyntheticCamera& SyntheticCamera::operator=(SyntheticCamera&&) noexcept = default;
 
+int SyntheticCamera::hand_count() const { return state_->two_hands ? kTwoHands : 1; }
 const SynthOptions& SyntheticCamera::options() const { return state_->options; }
 const CameraIntrinsics& SyntheticCamera::camera() const { return state_->options.camera; }
-const SubjectScale& SyntheticCamera::subject() const { return state_->shape.subject; }
-const HandShape& SyntheticCamera::shape() const { return state_->shape; }
+const SubjectScale& SyntheticCamera::subject(int hand) const { return shape(hand).subject; }
+const HandShape& SyntheticCamera::shape(int hand) const {
+  if (hand < 0 || hand >= hand_count()) throw std::out_of_range("no hand " + std::to_string(hand));
+  return state_->shapes[static_cast<size_t>(hand)];
+}
 
-HandPose SyntheticCamera::pose(int frame) const {
-  return view_pose(state_->options.view, state_->motion.pose(frame), state_->shape);
+HandPose SyntheticCamera::pose(int frame, int hand) const {
+  const State& s = *state_;
+  (void)shape(hand);  // range check
+  if (s.two_hands) return s.two_hands->pose(frame)[static_cast<size_t>(hand)];
+  return view_pose(s.options.view, s.motion->pose(frame), s.shapes[0]);
 }
 
 SynthFrame SyntheticCamera::render(int frame) {
@@ -177,20 +210,73 @@ SynthFrame SyntheticCamera::render(int frame) {
   return out;
 }
 
-void SyntheticCamera::render(int frame, SynthFrame& out) { render_pose(pose(frame), frame, out); }
+void SyntheticCamera::render(int frame, SynthFrame& out) {
+  if (state_->two_hands) {
+    state_->render_two_hands(frame, out);
+  } else {
+    render_pose(pose(frame), frame, out);
+  }
+}
 
 void SyntheticCamera::render_pose(const HandPose& pose, int frame, SynthFrame& out) {
   State& s = *state_;
-  const CameraIntrinsics& cam = s.options.camera;
+  if (s.two_hands) throw std::logic_error("render_pose: one-hand motions only, not " + s.options.motion);
+  const HandShape& shape = s.shapes[0];
   out.frame = frame;
   out.pose = pose;
-  out.joints = camera_frame_joints(s.shape, out.pose);
+  out.joints = camera_frame_joints(shape, out.pose);
   out.fingertips = fingertips_from_joints(out.joints);
 
-  posed_primitives(s.shape, out.pose, out.joints, s.primitives);
+  posed_primitives(shape, out.pose, out.joints, s.primitives);
   s.raycaster = s.background;  // same sizes: no allocation
   for (const auto& p : s.primitives) s.raycaster.draw(p);
+  s.develop(frame, out);
+  if (s.options.hand == Handedness::kLeft) mirror(out);
+  out.hand_count = 1;
+  out.hands[0] = SynthHand{s.options.hand, out.pose, out.joints, out.fingertips};
+  out.hand_index.width = out.hand_index.height = 0;
+  out.hand_index.pixels.clear();
+}
 
+void SyntheticCamera::State::render_two_hands(int frame, SynthFrame& out) {
+  const TwoHandPoses poses = two_hands->pose(frame);
+  raycaster = background;  // same sizes: no allocation
+  for (size_t k = 0; k < kTwoHands; ++k) {
+    SynthHand& hand = out.hands[k];
+    hand.hand = k == 0 ? Handedness::kRight : Handedness::kLeft;
+    hand.pose = poses[k];
+    hand.joints = camera_frame_joints(shapes[k], hand.pose);
+    posed_primitives(shapes[k], hand.pose, hand.joints, primitives);
+    if (hand.hand == Handedness::kLeft) {  // the model's mirror image, in 3D: one z-buffer for both
+      mirror_x(hand.joints);
+      mirror_x(primitives);
+    }
+    hand.fingertips = fingertips_from_joints(hand.joints);
+    for (auto& p : primitives) {
+      p.label |= static_cast<int>(k + 1) << kHandTagShift;
+      raycaster.draw(p);
+    }
+  }
+  out.frame = frame;
+  out.hand_count = kTwoHands;
+  out.pose = out.hands[0].pose;
+  out.joints = out.hands[0].joints;
+  out.fingertips = out.hands[0].fingertips;
+  develop(frame, out);
+  // Split the tags off: labels keep the part, hand_index the hand.
+  out.hand_index.width = out.labels.width;
+  out.hand_index.height = out.labels.height;
+  out.hand_index.channels = 1;
+  out.hand_index.pixels.resize(out.labels.pixels.size());
+  constexpr uint8_t kPartMask = (1 << kHandTagShift) - 1;
+  for (size_t i = 0; i < out.labels.pixels.size(); ++i) {
+    out.hand_index.pixels[i] = static_cast<uint8_t>(out.labels.pixels[i] >> kHandTagShift);
+    out.labels.pixels[i] &= kPartMask;
+  }
+}
+
+void SyntheticCamera::State::develop(int frame, SynthFrame& out) const {
+  const CameraIntrinsics& cam = options.camera;
   const size_t n = static_cast<size_t>(cam.width) * static_cast<size_t>(cam.height);
   out.depth.camera = cam;
   out.depth.depth_mm.resize(n);
@@ -198,13 +284,13 @@ void SyntheticCamera::render_pose(const HandPose& pose, int frame, SynthFrame& o
   out.labels.height = cam.height;
   out.labels.channels = 1;
   out.labels.pixels.resize(n);
-  if (s.options.noise) {
-    s.apply_noise(frame, out);
+  if (options.noise) {
+    apply_noise(frame, out);
   } else {
-    const auto& clean = s.raycaster.depth_mm();
-    const auto& labels = s.raycaster.labels();
-    const auto lo = static_cast<float>(s.options.noise_params.min_range_mm);
-    const auto hi = static_cast<float>(s.options.noise_params.max_range_mm);
+    const auto& clean = raycaster.depth_mm();
+    const auto& labels = raycaster.labels();
+    const auto lo = static_cast<float>(options.noise_params.min_range_mm);
+    const auto hi = static_cast<float>(options.noise_params.max_range_mm);
     for (size_t i = 0; i < n; ++i) {
       const float z = clean[i];
       const bool valid = z >= lo && z <= hi;
@@ -212,7 +298,6 @@ void SyntheticCamera::render_pose(const HandPose& pose, int frame, SynthFrame& o
       out.labels.pixels[i] = valid ? labels[i] : uint8_t{0};
     }
   }
-  if (s.options.hand == Handedness::kLeft) mirror(out);
 }
 
 void SyntheticCamera::State::apply_noise(int frame, SynthFrame& out) const {

@@ -89,6 +89,121 @@ TEST_F(SequenceIo, RoundTripKeepsDepthGroundTruthJointsAndLabels) {
   (void)cam;
 }
 
+// The CSV header of `hands` hands' fingertips as docs/SEQUENCES.md spells it out.
+std::string fingertip_header(int hands) {
+  std::string h = "frame";
+  for (int hand = 0; hand < hands; ++hand) {
+    for (const char* finger : {"thumb", "index", "middle", "ring", "little"}) {
+      for (const char* axis : {"_x", "_y", "_z"}) h += std::string(",") + (hand == 1 ? "h1_" : "") + finger + axis;
+    }
+  }
+  return h;
+}
+
+std::string first_line(const fs::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
+TEST_F(SequenceIo, AOneHandSequenceKeepsSpecsColumnsAndNeedsNoHandJson) {
+  write_small();
+  EXPECT_EQ(first_line(dir_ / "groundtruth.csv"), fingertip_header(1));
+  EXPECT_EQ(first_line(dir_ / "groundtruth.csv"),
+            "frame,thumb_x,thumb_y,thumb_z,index_x,index_y,index_z,middle_x,middle_y,middle_z,ring_x,ring_y,ring_z,"
+            "little_x,little_y,little_z");
+  EXPECT_FALSE(fs::exists(dir_ / "hand.json"));
+  const SequenceReader r(dir_);
+  EXPECT_EQ(r.hand_count(), 1);
+  EXPECT_TRUE(r.hands().empty());
+  EXPECT_THROW((void)r.fingertips(0, 1), std::out_of_range);
+}
+
+// Two hands: hand.json names them, each CSV row holds hand 0's block then hand 1's (prefixed h1_);
+// a hand without ground truth in a frame has empty cells there and reads back as not annotated.
+TEST_F(SequenceIo, TwoHandRoundTripKeepsEachHandsBlock) {
+  CameraIntrinsics cam;
+  cam.width = 16;
+  cam.height = 12;
+  cam.cx = 8;
+  cam.cy = 6;
+  const auto joints_of = [](double offset) {
+    Joints j;
+    for (int k = 0; k < kNumJoints; ++k) j[static_cast<size_t>(k)] = Eigen::Vector3d(k + offset, -k, 400 + offset);
+    return j;
+  };
+  {
+    SequenceWriter w(dir_, cam);
+    EXPECT_THROW(w.write_fingertips(0, Fingertips{}, 1), std::out_of_range) << "hand 1 before write_hands()";
+    EXPECT_THROW(w.write_hands({"right", "up"}), std::invalid_argument);
+    w.write_hands({"right", "left"}, {{"motion", "two_cross"}});
+    for (int f = 0; f < 2; ++f) {
+      w.write_depth(f, DepthImage{cam, std::vector<float>(16 * 12, 500.0F)});
+      Fingertips right, left;
+      right[kThumb] = Eigen::Vector3d(-100.5, 1, 350);
+      right[kLittle] = Eigen::Vector3d(-60, 2, 352.25);
+      left[kIndex] = Eigen::Vector3d(120, -3.5, 480);
+      w.write_fingertips(f, right, 0);
+      if (f == 0) w.write_fingertips(f, left, 1);  // frame 1: the left hand not annotated
+      w.write_joints(f, joints_of(0), 0);
+      if (f == 0) w.write_joints(f, joints_of(1000), 1);
+    }
+  }
+  EXPECT_EQ(first_line(dir_ / "groundtruth.csv"), fingertip_header(2));
+  EXPECT_NE(first_line(dir_ / "joints.csv").find(",little_tip_z,h1_wrist_x,h1_wrist_y,"), std::string::npos);
+  EXPECT_EQ(read_hand_json(dir_ / "hand.json"), (std::vector<std::string>{"right", "left"}));
+
+  const SequenceReader r(dir_);
+  ASSERT_EQ(r.hand_count(), 2);
+  EXPECT_EQ(r.hands(), (std::vector<std::string>{"right", "left"}));
+  const auto right0 = r.fingertips(0);  // hand 0 by default, as for one hand
+  ASSERT_TRUE(right0[kThumb].has_value());
+  EXPECT_NEAR((*right0[kThumb] - Eigen::Vector3d(-100.5, 1, 350)).norm(), 0.0, 1e-3);
+  EXPECT_FALSE(right0[kIndex].has_value());
+  const auto left0 = r.fingertips(0, 1);
+  ASSERT_TRUE(left0[kIndex].has_value());
+  EXPECT_NEAR((*left0[kIndex] - Eigen::Vector3d(120, -3.5, 480)).norm(), 0.0, 1e-3);
+  EXPECT_FALSE(left0[kThumb].has_value());
+  for (const auto& tip : r.fingertips(1, 1)) EXPECT_FALSE(tip.has_value()) << "frame 1's left hand is not annotated";
+  EXPECT_TRUE(r.fingertips(1, 0)[kLittle].has_value());
+  ASSERT_TRUE(r.joints(0, 1).has_value());
+  EXPECT_NEAR((*r.joints(0, 1))[20].x(), 1020.0, 1e-9);
+  EXPECT_NEAR((*r.joints(1, 0))[20].x(), 20.0, 1e-9);
+  EXPECT_FALSE(r.joints(1, 1).has_value());
+  EXPECT_THROW((void)r.fingertips(0, 2), std::out_of_range);
+}
+
+TEST_F(SequenceIo, HandJsonAndTwoHandColumnsThatDisagreeNameTheFileAndField) {
+  write_small();  // one hand's columns
+  write_text(dir_ / "hand.json", R"({"hands":["right","left"]})");
+  expect_error([&] { SequenceReader r(dir_); }, "groundtruth.csv", "expected 31 cells, found 16");
+  // Two hands' columns without hand.json naming them.
+  fs::remove(dir_ / "hand.json");
+  fs::remove(dir_ / "joints.csv");
+  write_text(dir_ / "groundtruth.csv", fingertip_header(2) + "\n0" + std::string(30, ',') + "\n");
+  expect_error([&] { SequenceReader r(dir_); }, "groundtruth.csv", "2 hands' columns: hand.json must name them");
+  write_text(dir_ / "hand.json", R"({"hands":["right","left"],"view":"palm"})");
+  EXPECT_EQ(SequenceReader(dir_).hand_count(), 2);
+  for (const char* bad : {R"({"hands":["right","middle"]})", R"({"hands":[]})", R"({"hands":"right"})",
+                          R"({"hands":["left","right","left"]})", R"({"hands":[1]})"}) {
+    write_text(dir_ / "hand.json", bad);
+    expect_error([&] { SequenceReader r(dir_); }, "hand.json", "field 'hands' must list 1 to 2");
+  }
+  write_text(dir_ / "hand.json", R"({"view":"palm"})");
+  expect_error([&] { SequenceReader r(dir_); }, "hand.json", "missing field 'hands'");
+  write_text(dir_ / "hand.json", "{");
+  expect_error([&] { SequenceReader r(dir_); }, "hand.json", "not valid JSON");
+  // A player never reads it.
+  EXPECT_EQ(SequenceReader(dir_, SequenceReader::Annotations::kIgnore).hand_count(), 1);
+  // A hand's joints either all given or none.
+  write_text(dir_ / "hand.json", R"({"hands":["right","left"]})");
+  std::string row = "0";
+  for (int k = 0; k < 2 * 3 * kNumJoints; ++k) row += k == 70 ? "," : ",1";
+  write_text(dir_ / "joints.csv", row + "\n");
+  expect_error([&] { SequenceReader r(dir_); }, "joints.csv", "frame 0: empty cell");
+}
+
 TEST_F(SequenceIo, MissingOrCorruptFilesGiveOneClearError) {
   write_small();
   fs::remove(dir_ / "depth" / "000001.png");

@@ -229,6 +229,48 @@ TEST_F(Handtrackd, CatPrintsEachFramesHandsWithIdAndHandedness) {
   EXPECT_GE(right, 27) << "of 30 frames seen as a right hand";
 }
 
+// Two hands end to end (issue 14): the synthetic two_apart scene (a right and a left hand) through
+// handtrackd (the second hand optimized on the side thread) to handtrack-cat: every frame has both
+// hands, one left and one right, each with its own id that it keeps; the right hand is the one on
+// the image's left (negative x), as the scene places it.
+TEST_F(Handtrackd, CatPrintsBothHandsOfATwoHandScene) {
+  ShmName shm("two");
+  Child cat({kCat, "--shm-name", shm.str(), "--count", "40", "--timeout", "30", "--from-start"}, dir_ / "cat.out",
+            dir_ / "cat.err");
+  const auto r = run(daemon_args({"--source", "synthetic:two_apart", "--fast", "--frames", "50", "--shm-name",
+                                  shm.str()}),
+                     dir_, "daemon", 60s);
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_EQ(cat.wait(30s), 0) << cat.err();
+  const auto frames = parse_lines(cat.out());
+  ASSERT_EQ(frames.size(), 40U);
+  std::uint32_t right_id = 0;
+  std::uint32_t left_id = 0;
+  int both_sides = 0;
+  for (const auto& f : frames) {
+    ASSERT_EQ(f.at("hands").size(), 2U) << "two hands in view: " << f.dump().substr(0, 300);
+    std::uint32_t ids[2] = {};
+    double x[2] = {};
+    std::string side[2];
+    for (int k = 0; k < 2; ++k) {
+      const json& hand = f.at("hands")[static_cast<size_t>(k)];
+      ids[k] = hand.at("hand_id").get<std::uint32_t>();
+      side[k] = hand.at("handedness").get<std::string>();
+      x[k] = hand.at("joints")[0][0].get<double>();  // the wrist
+    }
+    EXPECT_NE(ids[0], ids[1]);
+    const int r_index = x[0] < x[1] ? 0 : 1;  // the hand on the image's left is the right hand
+    both_sides += side[r_index] == "right" && side[1 - r_index] == "left";
+    if (right_id != 0) {
+      EXPECT_EQ(ids[r_index], right_id) << "the right hand keeps its id";
+      EXPECT_EQ(ids[1 - r_index], left_id) << "the left hand keeps its id";
+    }
+    right_id = ids[r_index];
+    left_id = ids[1 - r_index];
+  }
+  EXPECT_GE(both_sides, 38) << "of 40 frames with each hand's side right";
+}
+
 // ---- sd_notify -------------------------------------------------------------------------------
 
 class NotifyListener {

@@ -1,6 +1,7 @@
 // libFuzzer + ASan/UBSan: the sequence CSV readers (groundtruth.csv, joints.csv; core/src/
 // sequence.cpp) on arbitrary bytes, inside an otherwise valid sequence directory. The first byte
-// picks the file. A bad file must throw one std::runtime_error.
+// picks the file (bit 0) and whether hand.json names two hands (bit 1: two blocks per row). A bad
+// file must throw one std::runtime_error.
 #include "fuzz_input.hpp"
 
 #include "handtrack/core/png_io.hpp"
@@ -39,11 +40,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const bool joints = (data[0] & 1) != 0;
   std::filesystem::remove(dir / "groundtruth.csv");
   std::filesystem::remove(dir / "joints.csv");
+  std::filesystem::remove(dir / "hand.json");
+  if ((data[0] & 2) != 0) handtrack::write_hand_json(dir / "hand.json", {"right", "left"});
   handtrack::fuzz::write_file(dir / (joints ? "joints.csv" : "groundtruth.csv"), data + 1, size - 1);
   try {
     const handtrack::SequenceReader reader(dir);
-    (void)reader.fingertips(0);
-    (void)reader.joints(0);
+    for (int hand = 0; hand < reader.hand_count(); ++hand) {
+      (void)reader.fingertips(0, hand);
+      (void)reader.joints(0, hand);
+    }
   } catch (const std::runtime_error&) {
   }
   return 0;

@@ -539,3 +539,223 @@ TEST(SynthViews, EachViewTurnsThePoseAsItsNameSays) {
 }
 
 }  // namespace
+
+// Two hands at once (issue 14): a right and a left hand in one z-buffered image, each with its own
+// subject and ground truth that agrees with the pixels.
+namespace {
+
+using handtrack::kThumb;
+using handtrack::kLittle;
+
+// Hand k's solids as the camera sees them (hand 1 is the mirror image of the model in its pose).
+std::vector<ConeSphere> camera_solids(const SyntheticCamera& cam, int frame, int hand) {
+  const HandPose pose = cam.pose(frame, hand);
+  std::vector<ConeSphere> solids;
+  posed_primitives(cam.shape(hand), pose, camera_frame_joints(cam.shape(hand), pose), solids);
+  if (hand == 1) mirror_x(solids);
+  return solids;
+}
+
+TEST(SynthGeometry, SurfaceGapOfConeSpheres) {
+  // Spheres 30 mm apart, radii 10 and 5: 15 mm between the surfaces.
+  const ConeSphere a{{0, 0, 400}, {0, 0, 400}, 10.0, 10.0, 0};
+  const ConeSphere b{{30, 0, 400}, {30, 0, 400}, 5.0, 5.0, 0};
+  EXPECT_NEAR(surface_gap_mm(a, b), 15.0, 1e-3);
+  // A tapered capsule along x (radius 4 -> 12 over 100 mm) and a sphere above its middle: the
+  // nearest ball is not under the sphere's centre, so the gap is below 40 - 8 - 5 = 27 mm:
+  // min_s sqrt((100 s - 50)^2 + 40^2) - (4 + 8 s) - 5, solved numerically below.
+  const ConeSphere cone{{0, 0, 0}, {100, 0, 0}, 4.0, 12.0, 0};
+  const ConeSphere above{{50, 40, 0}, {50, 40, 0}, 5.0, 5.0, 0};
+  double expected = 1e9;
+  for (int i = 0; i <= 100000; ++i) {
+    const double s = i / 100000.0;
+    expected = std::min(expected, std::hypot(100 * s - 50, 40.0) - (4 + 8 * s) - 5);
+  }
+  EXPECT_LT(expected, 26.9);
+  EXPECT_NEAR(surface_gap_mm(cone, above), expected, 1e-3);
+  // Crossing capsules overlap: minus the deepest overlap of their balls (radius 6 + 6 at one point).
+  const ConeSphere x{{-50, 0, 0}, {50, 0, 0}, 6.0, 6.0, 0};
+  const ConeSphere y{{0, -50, 3}, {0, 50, 3}, 6.0, 6.0, 0};
+  EXPECT_NEAR(surface_gap_mm(x, y), 3.0 - 12.0, 1e-3);
+  EXPECT_NEAR(surface_gap_mm(std::vector<ConeSphere>{a, x}, std::vector<ConeSphere>{b, y}), -9.0, 1e-3);
+}
+
+TEST(SynthTwoHands, EveryTwoHandMotionShowsARightAndALeftHandWhoseGroundTruthIsOnTheirPixels) {
+  for (auto name : kTwoHandMotionNames) {
+    SyntheticCamera cam(clean_options(std::string(name)));
+    ASSERT_EQ(cam.hand_count(), 2);
+    int tips = 0, on_own_distal = 0;
+    for (int i : {0, 37, 75, 150, 220, 299}) {
+      SCOPED_TRACE(std::string(name) + " frame " + std::to_string(i));
+      const SynthFrame f = cam.render(i);
+      ASSERT_EQ(f.hand_count, 2);
+      EXPECT_EQ(f.hands[0].hand, Handedness::kRight);
+      EXPECT_EQ(f.hands[1].hand, Handedness::kLeft);
+      ASSERT_EQ(f.hand_index.pixels.size(), f.labels.pixels.size());
+      // Both hands in view; labels 1..12 on both, and nothing but hands and their forearms indexed.
+      std::array<int, 2> labelled{};
+      for (size_t p = 0; p < f.labels.pixels.size(); ++p) {
+        const int k = f.hand_index.pixels[p];
+        ASSERT_LE(k, 2);
+        ASSERT_LE(f.labels.pixels[p], handtrack::kNumPartLabels);
+        if (f.labels.pixels[p] != 0) {
+          ASSERT_GT(k, 0) << "a part label outside both hands";
+          ++labelled[static_cast<size_t>(k - 1)];
+        }
+      }
+      EXPECT_GT(labelled[0], 300);
+      EXPECT_GT(labelled[1], 300);
+      for (int k = 0; k < 2; ++k) {
+        const SynthHand& hand = f.hands[static_cast<size_t>(k)];
+        // The ground truth is the hand's own: its model's joints (mirrored for the left hand).
+        Joints expected = camera_frame_joints(cam.shape(k), cam.pose(i, k));
+        if (k == 1) mirror_x(expected);
+        for (size_t j = 0; j < expected.size(); ++j) EXPECT_EQ(hand.joints[j], expected[j]);
+        for (int finger = 0; finger < kNumFingers; ++finger) {
+          const Eigen::Vector3d tip = *hand.fingertips[static_cast<size_t>(finger)];
+          const int index = pixel_index(cam.camera(), cam.camera().project(tip));
+          ASSERT_GE(index, 0) << "hand " << k << " finger " << finger << " outside the image";
+          ++tips;
+          const auto p = static_cast<size_t>(index);
+          const double radius = cam.shape(k).fingers[static_cast<size_t>(finger)].radius_mm[3];
+          // The tip sphere covers its centre's pixel, so something is seen there: the sphere's front
+          // (tip z - radius), or a surface in front of it (the other hand, or its own fingers).
+          ASSERT_GT(f.depth.depth_mm[p], 0.0F);
+          EXPECT_LT(f.depth.depth_mm[p], tip.z() - radius + 1.5) << "hand " << k << " finger " << finger;
+          if (f.hand_index.pixels[p] == k + 1 && f.labels.pixels[p] == handtrack::part_label(finger, 2)) {
+            ++on_own_distal;
+            // Seen from the side, the pixel shows the tip sphere's front; a distal bone pointing
+            // away from the camera (a curled finger) may hide it behind the bone's own skin.
+            const Eigen::Vector3d bone = (tip - hand.joints[handtrack::joint_index(finger, 2)]).normalized();
+            if (std::abs(bone.dot(tip.normalized())) < 0.5) {
+              EXPECT_NEAR(f.depth.depth_mm[p], tip.z() - radius, 1.5) << "hand " << k << " finger " << finger;
+            }
+          }
+        }
+      }
+    }
+    EXPECT_GT(on_own_distal, tips * 6 / 10) << name << ": most fingertips are seen on their own hand";
+  }
+}
+
+TEST(SynthTwoHands, StayAtDeskDistancesWithinJointLimitsAndInTheImage) {
+  const JointLimits limits = JointLimits::defaults();
+  for (auto name : kTwoHandMotionNames) {
+    SyntheticCamera cam(clean_options(std::string(name)));
+    for (int i = 0; i < 600; i += 5) {
+      for (int k = 0; k < 2; ++k) {
+        const HandPose p = cam.pose(i, k);
+        ASSERT_TRUE(limits.contains(p)) << name << " frame " << i;
+        Eigen::Vector3d palm = p.translation_mm + camera_R_hand(p.rotation) * cam.shape(k).palm_centre_mm;
+        if (k == 1) palm.x() = -palm.x();
+        EXPECT_GT(palm.z(), 300.0) << name << " hand " << k << " frame " << i;
+        EXPECT_LT(palm.z(), 550.0) << name << " hand " << k << " frame " << i;
+        const Eigen::Vector2d uv = cam.camera().project(palm);
+        EXPECT_TRUE(uv.x() > 0 && uv.x() < 320 && uv.y() > 0 && uv.y() < 240) << name << " palm leaves the image";
+      }
+    }
+  }
+}
+
+// Mirror images have the other chirality: with both palms toward the camera (two_apart), the right
+// hand's thumb is on the image's right of its little finger, the left hand's on the left. The
+// right hand is on the image's left (a desk camera facing the user), each hand its own subject.
+TEST(SynthTwoHands, TheLeftHandIsAMirroredHandWithItsOwnSubject) {
+  SyntheticCamera cam(clean_options("two_apart"));
+  for (int i : {0, 100, 250}) {
+    const SynthFrame f = cam.render(i);
+    const auto& right = f.hands[0];
+    const auto& left = f.hands[1];
+    EXPECT_GT(right.fingertips[kThumb]->x(), right.fingertips[kLittle]->x()) << "frame " << i;
+    EXPECT_LT(left.fingertips[kThumb]->x(), left.fingertips[kLittle]->x()) << "frame " << i;
+    const double apart = (left.joints[handtrack::joint_index(2, 0)] - right.joints[handtrack::joint_index(2, 0)]).x();
+    EXPECT_GT(apart, 150.0) << "frame " << i;
+    EXPECT_LT(apart, 250.0) << "frame " << i;
+  }
+  EXPECT_NE(cam.subject(0).length, cam.subject(1).length);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_GE(cam.subject(k).length, 0.9);
+    EXPECT_LE(cam.subject(k).length, 1.1);
+  }
+  // Hand 0 is the subject a one-hand motion of the same seed has; frames are a function of
+  // (options, frame).
+  EXPECT_EQ(cam.subject(0).length, SyntheticCamera(clean_options("pinch")).subject().length);
+  SynthOptions noisy = clean_options("two_apart");
+  noisy.noise = true;
+  SyntheticCamera a(noisy), b(noisy);
+  (void)a.render(7);
+  EXPECT_EQ(a.render(42).depth.depth_mm, b.render(42).depth.depth_mm);
+  EXPECT_EQ(a.render(42).hand_index.pixels, b.render(42).hand_index.pixels);
+  // A one-hand frame: one hand, the legacy fields its own, no hand index.
+  const SynthFrame one = SyntheticCamera(clean_options("pinch")).render(5);
+  EXPECT_EQ(one.hand_count, 1);
+  EXPECT_EQ(one.hands[0].joints, one.joints);
+  EXPECT_TRUE(one.hand_index.pixels.empty());
+}
+
+// two_cross: the right hand passes in front of the left, the two swap sides in the image, and the
+// near hand hides part of the far one while they cross.
+TEST(SynthTwoHands, InTwoCrossTheHandsSwapSidesAndTheNearOneHidesTheFarOne) {
+  SyntheticCamera cam(clean_options("two_cross"));
+  const auto centre_u = [&](const SynthHand& h) {
+    return cam.camera().project(h.joints[handtrack::joint_index(2, 0)]).x();
+  };
+  bool swapped = false;
+  int most_far_pixels = 0, fewest_far_pixels = 1 << 30;
+  for (int i = 0; i < 300; i += 4) {
+    const SynthFrame f = cam.render(i);
+    if (i == 0) {
+      EXPECT_LT(centre_u(f.hands[0]), centre_u(f.hands[1]) - 80) << "the right hand starts on the left";
+    }
+    swapped = swapped || centre_u(f.hands[0]) > centre_u(f.hands[1]) + 80;
+    EXPECT_LT(f.hands[0].joints[0].z(), f.hands[1].joints[0].z() - 80) << "frame " << i;
+    const int far_pixels = static_cast<int>(std::count(f.hand_index.pixels.begin(), f.hand_index.pixels.end(), 2));
+    most_far_pixels = std::max(most_far_pixels, far_pixels);
+    fewest_far_pixels = std::min(fewest_far_pixels, far_pixels);
+  }
+  EXPECT_TRUE(swapped) << "the hands never crossed";
+  EXPECT_LT(fewest_far_pixels, most_far_pixels * 2 / 3) << "the near hand never hid the far one";
+}
+
+// Hands may touch (two_clap: the palms meet) but never pass through each other; apart they stay
+// apart.
+TEST(SynthTwoHands, HandsTouchButNeverPassThroughEachOther) {
+  for (auto name : kTwoHandMotionNames) {
+    SyntheticCamera cam(clean_options(std::string(name)));
+    double closest = 1e9, farthest = -1e9;
+    for (int i = 0; i < 300; i += 3) {
+      const double gap = surface_gap_mm(camera_solids(cam, i, 0), camera_solids(cam, i, 1));
+      closest = std::min(closest, gap);
+      farthest = std::max(farthest, gap);
+    }
+    std::printf("%s: hands %.1f to %.1f mm apart\n", std::string(name).c_str(), closest, farthest);
+    EXPECT_GT(closest, -0.5) << name << ": the hands pass through each other";
+    if (name == "two_clap") {
+      EXPECT_LT(closest, 1.0) << "the palms never touch";
+      EXPECT_GT(farthest, 80.0) << "the hands never part";
+    }
+    if (name == "two_apart") {
+      EXPECT_GT(closest, 40.0);
+    }
+    if (name == "two_pinch") {
+      EXPECT_GT(closest, 20.0);
+    }
+  }
+}
+
+TEST(SynthTwoHands, RejectsAHandOrViewAndSinglePoses) {
+  SynthOptions o = clean_options("two_clap");
+  o.hand = Handedness::kLeft;
+  EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
+  o = clean_options("two_clap");
+  o.view = View::kBack;
+  EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
+  SyntheticCamera cam(clean_options("two_pinch"));
+  SynthFrame f;
+  EXPECT_THROW(cam.render_pose(cam.pose(0), 0, f), std::logic_error);
+  EXPECT_THROW((void)cam.pose(0, 2), std::out_of_range);
+  EXPECT_TRUE(is_two_hand_motion("two_cross"));
+  EXPECT_FALSE(is_two_hand_motion("pinch"));
+}
+
+}  // namespace

@@ -1,6 +1,7 @@
 // handtrack-eval on sequences it cannot score (issue 13): one clear line and a failing exit code,
 // never a table of `nan`s with exit 0. And the benchmark's groups: sequences pooled by the view,
-// motion and hand their hand.json names, frames without a pose counted as misses.
+// motion and hand their hand.json names, frames without a pose counted as misses. And two hands
+// (issue 14): a sequence whose hand.json names two is scored per hand.
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
 
@@ -114,6 +115,66 @@ TEST_F(EvalCli, GroupsSequencesByTheViewMotionAndHandTheirHandJsonNames) {
   EXPECT_LT(g.at("view").at("palm").at("mean_fingertip_error_mm").get<double>(), 30.0);
   EXPECT_EQ(j.at("sequences").at(2).at("view"), "head-mounted");
   EXPECT_DOUBLE_EQ(j.at("overall").at("pct_frames_without_pose").get<double>(), 100.0 * 4 / 16);
+}
+
+// A rendered two-hand sequence (hand.json: right, left) is tracked with HandsTracker and scored per
+// hand beside the one-hand keys; a one-hand sequence is scored per hand only with --max-hands 2.
+TEST_F(EvalCli, ATwoHandSequenceIsScoredPerHandAndAOneHandOneOnlyWhenAsked) {
+  handtrack::synth::SynthOptions o;
+  o.motion = "two_apart";
+  o.frames = 8;
+  handtrack::synth::SyntheticCamera cam(o);
+  {
+    handtrack::SequenceWriter writer(dir_ / "pair", cam.camera());
+    writer.write_hands({"right", "left"}, {{"motion", o.motion}});
+    for (int f = 0; f < o.frames; ++f) {
+      const auto frame = cam.render(f);
+      writer.write_depth(f, frame.depth);
+      for (int h = 0; h < frame.hand_count; ++h) writer.write_fingertips(f, frame.hands[static_cast<size_t>(h)].fingertips, h);
+    }
+  }
+  const fs::path json = dir_ / "eval.json", tips = dir_ / "tips.csv";
+  const std::string pair = "'" + (dir_ / "pair").string() + "'", empty = "'" + (dir_ / "seq").string() + "'";
+  std::string err;
+  ASSERT_EQ(eval(&err, pair + " " + empty + " --json '" + json.string() + "' --tips-csv '" + tips.string() + "'"), 0)
+      << err;
+  {
+    std::ifstream in(json);
+    const auto j = nlohmann::json::parse(in);
+    const auto& seq = j.at("sequences").at(0);
+    EXPECT_EQ(seq.at("frames"), 8);
+    EXPECT_TRUE(seq.contains("mean_fingertip_error_mm") && seq.contains("pct_frames_below_mm"));
+    const auto& hands = seq.at("hands");
+    ASSERT_EQ(hands.size(), 2U);
+    for (size_t k = 0; k < 2; ++k) {
+      SCOPED_TRACE("hand " + std::to_string(k));
+      EXPECT_EQ(hands.at(k).at("hand"), k);
+      EXPECT_EQ(hands.at(k).at("side"), k == 0 ? "right" : "left");
+      EXPECT_EQ(hands.at(k).at("frames"), 8);
+      EXPECT_LE(hands.at(k).at("misses").get<int>(), 2);
+      EXPECT_LT(hands.at(k).at("mean_fingertip_error_mm").get<double>(), 30.0);
+      EXPECT_TRUE(hands.at(k).contains("identity_swaps_per_1000_frames"));
+      EXPECT_TRUE(hands.at(k).at("handedness").contains("pct_frames_correct"));
+    }
+    EXPECT_TRUE(seq.contains("phantom_frames"));
+    EXPECT_EQ(j.at("overall").at("hands").size(), 2U);
+    EXPECT_FALSE(j.at("sequences").at(1).contains("hands")) << "a one-hand sequence stays one-hand";
+  }
+  std::ifstream tips_in(tips);
+  std::stringstream tips_text;
+  tips_text << tips_in.rdbuf();
+  EXPECT_NE(tips_text.str().find("\npair/h1,7,"), std::string::npos) << "a --tips-csv row per hand and frame";
+
+  // --max-hands 2: the empty one-hand sequence through HandsTracker, its hand missed in every frame.
+  ASSERT_EQ(eval(&err, pair + " " + empty + " --max-hands 2 --json '" + json.string() + "'"), 0) << err;
+  std::ifstream in(json);
+  const auto j = nlohmann::json::parse(in);
+  const auto& one = j.at("sequences").at(1);
+  ASSERT_EQ(one.at("hands").size(), 1U);
+  EXPECT_EQ(one.at("hands").at(0).at("misses"), 4);
+  EXPECT_EQ(one.at("frames_without_pose"), 4);
+  EXPECT_EQ(eval(&err, pair + " --max-hands 3"), 1);
+  EXPECT_NE(err.find("--max-hands"), std::string::npos) << err;
 }
 
 }  // namespace

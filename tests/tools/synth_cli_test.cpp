@@ -96,7 +96,8 @@ TEST_F(SynthCli, HelpAndListMotions) {
   EXPECT_NE(help.out.find("--subject-scale"), std::string::npos);
   const RunResult list = run("--list-motions");
   EXPECT_EQ(list.exit_code, 0);
-  for (const char* m : {"adbadd", "fingercount", "fingerwave", "flexex1", "pinch", "random", "tigergrasp"}) {
+  for (const char* m : {"adbadd", "fingercount", "fingerwave", "flexex1", "pinch", "random", "tigergrasp", "two_apart",
+                        "two_clap", "two_cross", "two_pinch"}) {
     EXPECT_NE(list.out.find(m), std::string::npos) << m;
   }
 }
@@ -159,6 +160,43 @@ TEST_F(SynthCli, Writes640x480SequenceWithConsistentGroundTruth) {
   const RunResult forced = run(again + " --force --no-noise --background none");
   EXPECT_EQ(forced.exit_code, 0) << forced.err;
   EXPECT_EQ(handtrack::SequenceReader(seq).frame_count(), 3u);
+}
+
+// A two-hand motion writes both hands (docs/SEQUENCES.md): hand.json names them, each CSV row holds
+// hand 0's block then hand 1's (h1_...), and each hand's tips are its joints' tips. --hand and
+// --view, which it has no use for, are refused.
+TEST_F(SynthCli, ATwoHandMotionWritesBothHandsGroundTruth) {
+  const fs::path seq = dir_ / "pair";
+  const std::string out = "--out '" + seq.string() + "'";
+  expect_one_line_error("--motion two_cross --frames 3 --hand left " + out, "--hand does not apply");
+  expect_one_line_error("--motion two_cross --frames 3 --view back " + out, "--view does not apply");
+  const RunResult r = run("--motion two_cross --frames 5 --seed 3 " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(seq / "hand.json")),
+            nlohmann::json::parse(R"({"hands":["right","left"],"motion":"two_cross"})"));
+  const std::string header = slurp(seq / "groundtruth.csv").substr(0, slurp(seq / "groundtruth.csv").find('\n'));
+  EXPECT_NE(header.find(",little_z,h1_thumb_x,h1_thumb_y,h1_thumb_z,"), std::string::npos) << header;
+  EXPECT_NE(slurp(seq / "poses.csv").find(",little_flex3,h1_tx,h1_ty,"), std::string::npos);
+  const auto subject = nlohmann::json::parse(slurp(seq / "subject.json"));
+  ASSERT_EQ(subject.at("hands").size(), 2U);
+  EXPECT_EQ(subject.at("hands").at(1).at("hand"), "left");
+
+  const handtrack::SequenceReader reader(seq);
+  ASSERT_EQ(reader.hand_count(), 2);
+  for (size_t i = 0; i < reader.frame_count(); ++i) {
+    for (int h = 0; h < 2; ++h) {
+      const auto joints = reader.joints(i, h);
+      ASSERT_TRUE(joints.has_value());
+      const auto tips = reader.fingertips(i, h);
+      for (int f = 0; f < handtrack::kNumFingers; ++f) {
+        ASSERT_TRUE(tips[static_cast<size_t>(f)].has_value());
+        EXPECT_LT((*tips[static_cast<size_t>(f)] - (*joints)[static_cast<size_t>(handtrack::fingertip_joint(f))]).norm(),
+                  1e-6);
+      }
+    }
+    // The right hand nearer (two_cross), and the hands apart.
+    EXPECT_LT((*reader.joints(i, 0))[0].z(), (*reader.joints(i, 1))[0].z());
+  }
 }
 
 }  // namespace

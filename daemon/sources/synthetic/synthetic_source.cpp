@@ -37,9 +37,10 @@ class SyntheticSource final : public DepthSource {
       }
     } else {
       const auto& names = synth::kMotionNames;
-      if (std::find(names.begin(), names.end(), motion) == names.end()) {
+      if (std::find(names.begin(), names.end(), motion) == names.end() && !synth::is_two_hand_motion(motion)) {
         std::string known;
         for (const auto name : names) known += (known.empty() ? "" : ", ") + std::string(name);
+        for (const auto name : synth::kTwoHandMotionNames) known += ", " + std::string(name);
         throw std::invalid_argument("synthetic:" + motion + ": unknown motion (known: " + known + ")");
       }
       cameras_.emplace_back(camera_options(motion, options));

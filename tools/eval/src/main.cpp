@@ -1,6 +1,11 @@
 // handtrack-eval: track sequence directories and score them against their ground truth with the
 // paper's metrics (Sec. 7). SPEC.md "Evaluation output".
+//
+// A sequence whose hand.json names two hands is tracked with HandsTracker and scored per hand
+// (eval::HandsScorer, docs/SEQUENCES.md); a one-hand sequence with the one-hand Tracker, unless
+// --max-hands 2 asks for HandsTracker there too (a second hand it reports is a phantom).
 #include "handtrack/core/hand_calibration.hpp"
+#include "handtrack/core/hands_tracker.hpp"
 #include "handtrack/core/part_forest.hpp"
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/core/tracker.hpp"
@@ -17,6 +22,10 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace fs = std::filesystem;
 using namespace handtrack;
@@ -30,37 +39,38 @@ std::string sequence_name(const fs::path& dir) {
   return name.empty() ? fs::path(dir).lexically_normal().parent_path().filename().string() : name;
 }
 
-// What a sequence's hand.json says (SPEC.md "Sequence directory"): {"hands":["left"]}, which hand
-// it shows, and, from handtrack-synth, "view" and "motion" (strings). Absent file: nothing known.
-// Anything else in it is an error naming the file.
+// What a sequence's hand.json says (SPEC.md "Sequence directory"): which hands it shows (read and
+// checked by SequenceReader), and, from handtrack-synth, "view" and "motion" (strings), by which the
+// scores are grouped. Absent file: nothing known. A view or motion that is not a string is an error
+// naming the file.
 struct SequenceInfo {
-  std::optional<Handedness> hand;
+  std::vector<std::optional<Handedness>> hands;  // per ground-truth hand; one unknown without hand.json
   std::string view;
   std::string motion;
 };
 
-SequenceInfo read_sequence_info(const fs::path& dir) {
-  const fs::path file = dir / "hand.json";
+// hand.json's names (SequenceReader checked them: "right" or "left") in the tracker's words.
+std::optional<Handedness> handedness_of(const std::string& name) {
+  for (const Handedness h : {Handedness::kRight, Handedness::kLeft}) {
+    if (name == to_string(h)) return h;
+  }
+  return std::nullopt;
+}
+
+SequenceInfo read_sequence_info(const SequenceReader& reader) {
   SequenceInfo info;
+  info.hands.resize(static_cast<size_t>(reader.hand_count()));
+  for (size_t k = 0; k < reader.hands().size(); ++k) info.hands[k] = handedness_of(reader.hands()[k]);
+  const fs::path file = reader.dir() / "hand.json";
   if (!fs::exists(file)) return info;
   std::ifstream in(file);
   const auto j = nlohmann::json::parse(in, nullptr, false);
-  const auto optional_string = [&](const char* key, std::string& out) {
-    if (!j.contains(key)) return true;
-    if (!j[key].is_string()) return false;
-    out = j[key].get<std::string>();
-    return true;
-  };
-  if (j.is_object() && j.contains("hands") && j["hands"].is_array() && j["hands"].size() == 1 &&
-      j["hands"][0].is_string() && optional_string("view", info.view) && optional_string("motion", info.motion)) {
-    const auto hand = j["hands"][0].get<std::string>();
-    if (hand == "left") info.hand = Handedness::kLeft;
-    if (hand == "right") info.hand = Handedness::kRight;
-    if (info.hand) return info;
+  for (const auto& [key, out] : {std::pair{"view", &info.view}, std::pair{"motion", &info.motion}}) {
+    if (!j.contains(key)) continue;
+    if (!j[key].is_string()) throw std::runtime_error(file.string() + ": field '" + key + "' must be a string");
+    *out = j[key].get<std::string>();
   }
-  throw std::runtime_error(file.string() +
-                           ": expected {\"hands\":[\"left\"]} or {\"hands\":[\"right\"]}, with optional string "
-                           "\"view\" and \"motion\"");
+  return info;
 }
 
 // --tips-csv: one row per frame with the estimated and the true fingertips.
@@ -86,6 +96,78 @@ void write_tips_row(std::ostream& out, const std::string& sequence, size_t frame
     }
   }
   out << '\n';
+}
+
+// What every sequence's frames share: the labeller (or the ground-truth labels behind
+// --oracle-labels), the --tips-csv file and the progress over all frames.
+struct FrameLoop {
+  const PixelLabeller* labeller = nullptr;
+  std::vector<uint8_t>* oracle_labels = nullptr;  // non-null: filled with each frame's labels/
+  std::ofstream* tips = nullptr;                  // open: --tips-csv
+  tools::Progress* progress = nullptr;
+  size_t done = 0;
+  size_t total = 0;
+
+  // Tracks every frame of `reader` with track(depth) (timed) and hands its output to
+  // score(i, output); returns the seconds spent tracking.
+  template <typename Track, typename Score>
+  double run(const SequenceReader& reader, Track&& track, Score&& score) {
+    double seconds = 0.0;
+    for (size_t i = 0; i < reader.frame_count(); ++i) {
+      const DepthImage depth = reader.depth(i);
+      if (oracle_labels != nullptr) *oracle_labels = reader.labels(i).value_or(Gray8Image{}).pixels;
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto out = track(depth);
+      seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      score(i, out);
+      progress->update(sequence_name(reader.dir()), static_cast<double>(++done) / static_cast<double>(total));
+    }
+    return seconds;
+  }
+  [[nodiscard]] bool writes_tips() const { return tips != nullptr && tips->is_open(); }
+};
+
+// One hand (SPEC.md): Tracker, scored by SequenceScorer.
+eval::SequenceScore evaluate_one_hand(const SequenceReader& reader, const SequenceInfo& info,
+                                      const TrackerConfig& config, FrameLoop& loop) {
+  Tracker tracker(config);
+  const std::string name = sequence_name(reader.dir());
+  eval::SequenceScorer scorer(name, info.hands.front());
+  const double seconds = loop.run(
+      reader, [&](const DepthImage& depth) { return tracker.track(depth, loop.labeller); },
+      [&](size_t i, const TrackerOutput& out) {
+        scorer.add(out, reader.fingertips(i));
+        if (loop.writes_tips()) {
+          write_tips_row(*loop.tips, name, i, static_cast<double>(i) / reader.camera().fps, out, reader.fingertips(i));
+        }
+      });
+  return scorer.finish(seconds);
+}
+
+// Several hands: HandsTracker with room for `max_hands`, each ground-truth hand scored against the
+// tracked hand matched to it (HandsScorer). --tips-csv: a row per ground-truth hand and frame, the
+// sequence named NAME/hK, with its matched hand (state no_hand where none matched).
+eval::SequenceScore evaluate_hands(const SequenceReader& reader, const SequenceInfo& info, TrackerConfig config,
+                                   int max_hands, FrameLoop& loop) {
+  config.max_hands = max_hands;
+  HandsTracker tracker(config);
+  const std::string name = sequence_name(reader.dir());
+  eval::HandsScorer scorer(name, info.hands);
+  std::vector<Fingertips> truth(info.hands.size());
+  const double seconds = loop.run(
+      reader, [&](const DepthImage& depth) { return tracker.track(depth, loop.labeller); },
+      [&](size_t i, const HandsOutput& out) {
+        for (size_t k = 0; k < truth.size(); ++k) truth[k] = reader.fingertips(i, static_cast<int>(k));
+        const std::span<const TrackerOutput> tracked(out.hands.data(), static_cast<size_t>(out.count));
+        const eval::HandMatch match = scorer.add(tracked, truth);
+        if (!loop.writes_tips()) return;
+        for (size_t k = 0; k < truth.size(); ++k) {
+          const int t = match.tracked_of_truth[k];
+          write_tips_row(*loop.tips, name + "/h" + std::to_string(k), i, static_cast<double>(i) / reader.camera().fps,
+                         t >= 0 ? tracked[static_cast<size_t>(t)] : TrackerOutput{}, truth[k]);
+        }
+      });
+  return scorer.finish(seconds);
 }
 
 }  // namespace
@@ -136,6 +218,12 @@ int main(int argc, char** argv) {
   app.add_option("--hand-profile", hand_profile, "hand profile (handtrack-calibrate): the user's hand scale (Sec. 6)");
   bool sim_only = false;
   app.add_flag("--sim-only", sim_only, "E_sim only: drop E_col, E_lim and E_smo (ablation of Fig. 6)");
+  int max_hands = kMaxHands;
+  app.add_option("--max-hands", max_hands,
+                 "hands HandsTracker may report (default 2); a sequence whose hand.json names two hands is always "
+                 "tracked with HandsTracker, a one-hand sequence only when this is given and > 1 (a second hand "
+                 "reported there is a phantom)")
+      ->check(CLI::Range(1, kMaxHands));
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
   if (energy == "late-fusion" && forest_file.empty() && !oracle_labels) {
     const auto shipped = shipped_forest_path();
@@ -182,26 +270,17 @@ int main(int argc, char** argv) {
       write_tips_header(tips_out);
     }
     tools::Progress progress(kProgram);
-    size_t done = 0;
+    FrameLoop loop;
+    loop.labeller = labeller;
+    loop.oracle_labels = labeller == &oracle ? &truth_labels : nullptr;
+    loop.tips = &tips_out;
+    loop.progress = &progress;
+    loop.total = total_frames;
+    const bool hands_asked = app.count("--max-hands") > 0 && max_hands > 1;
     for (const auto& reader : readers) {
-      Tracker tracker(config);
-      const SequenceInfo info = read_sequence_info(reader.dir());
-      eval::SequenceScorer scorer(sequence_name(reader.dir()), info.hand);
-      double seconds = 0.0;
-      for (size_t i = 0; i < reader.frame_count(); ++i) {
-        const DepthImage depth = reader.depth(i);
-        if (labeller == &oracle) truth_labels = reader.labels(i).value_or(Gray8Image{}).pixels;
-        const auto t0 = std::chrono::steady_clock::now();
-        const TrackerOutput out = tracker.track(depth, labeller);
-        seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        scorer.add(out, reader.fingertips(i));
-        if (tips_out.is_open()) {
-          write_tips_row(tips_out, sequence_name(reader.dir()), i, static_cast<double>(i) / reader.camera().fps, out,
-                         reader.fingertips(i));
-        }
-        progress.update(sequence_name(reader.dir()), static_cast<double>(++done) / static_cast<double>(total_frames));
-      }
-      scores.push_back(scorer.finish(seconds));
+      const SequenceInfo info = read_sequence_info(reader);
+      scores.push_back(reader.hand_count() > 1 || hands_asked ? evaluate_hands(reader, info, config, max_hands, loop)
+                                                              : evaluate_one_hand(reader, info, config, loop));
       scores.back().view = info.view;
       scores.back().motion = info.motion;
     }

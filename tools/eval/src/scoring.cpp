@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <stdexcept>
 
 namespace handtrack::eval {
 
@@ -70,11 +71,33 @@ SequenceScore SequenceScorer::finish(double tracking_seconds) {
   return score_;
 }
 
+namespace {
+// The scores of hand `index` of the sequences that have one, pooled; its side where they agree.
+SequenceScore pool_hand(const std::vector<SequenceScore>& sequences, size_t index) {
+  std::vector<SequenceScore> members;
+  for (const auto& s : sequences) {
+    if (index < s.hands.size()) members.push_back(s.hands[index]);
+  }
+  SequenceScore pooled = overall(members);
+  pooled.name = members.front().name;
+  pooled.expected_hand = members.front().expected_hand;
+  for (const auto& m : members) {
+    if (m.expected_hand != pooled.expected_hand) pooled.expected_hand.reset();
+  }
+  return pooled;
+}
+}  // namespace
+
 SequenceScore overall(const std::vector<SequenceScore>& sequences) {
   SequenceScore all;
   all.name = "overall";
   double seconds = 0.0;
+  size_t most_hands = 0;
   for (const auto& s : sequences) {
+    most_hands = std::max(most_hands, s.hands.size());
+    all.identity_swaps += s.identity_swaps;
+    all.phantom_frames += s.phantom_frames;
+    all.phantom_hands += s.phantom_hands;
     all.frames += s.frames;
     all.nan_poses += s.nan_poses;
     all.guided_wins += s.guided_wins;
@@ -88,7 +111,152 @@ SequenceScore overall(const std::vector<SequenceScore>& sequences) {
   }
   summarise(all);
   all.fps = seconds > 0.0 ? all.frames / seconds : 0.0;
+  for (size_t k = 0; k < most_hands; ++k) all.hands.push_back(pool_hand(sequences, k));
   return all;
+}
+
+std::optional<double> hand_distance_mm(const TrackerOutput& tracked, const Fingertips& truth) {
+  if (tracked.state == TrackingState::kNoHand) return std::nullopt;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (size_t f = 0; f < kNumFingers; ++f) {
+    if (!truth[f]) continue;
+    sum += tracked.fingertips[f] - *truth[f];
+    ++n;
+  }
+  if (n == 0) return std::nullopt;
+  const double d = sum.norm() / n;
+  return std::isfinite(d) ? std::optional<double>(d) : std::nullopt;
+}
+
+HandMatch match_hands(std::span<const TrackerOutput> tracked, std::span<const Fingertips> truth, double radius_mm) {
+  const size_t nt = tracked.size(), ng = truth.size();
+  // Admissible pairs: distance[t][g], or nullopt beyond the radius.
+  std::vector<std::vector<std::optional<double>>> distance(nt, std::vector<std::optional<double>>(ng));
+  for (size_t t = 0; t < nt; ++t) {
+    for (size_t g = 0; g < ng; ++g) {
+      const auto d = hand_distance_mm(tracked[t], truth[g]);
+      if (d && *d <= radius_mm) distance[t][g] = d;
+    }
+  }
+  // Depth-first over the tracked hands: each takes a free ground-truth hand within reach, or none.
+  // Best = the most pairs, then the smallest total distance (ties: the first found, so the result
+  // does not depend on floating-point noise in a symmetric case's order).
+  HandMatch best{std::vector<int>(nt, -1), std::vector<int>(ng, -1)};
+  int best_pairs = 0;
+  double best_total = 0.0;
+  HandMatch current = best;
+  const auto search = [&](const auto& self, size_t t, int pairs, double total) -> void {
+    if (t == nt) {
+      if (pairs > best_pairs || (pairs == best_pairs && total < best_total)) {
+        best = current;
+        best_pairs = pairs;
+        best_total = total;
+      }
+      return;
+    }
+    for (size_t g = 0; g < ng; ++g) {
+      if (!distance[t][g] || current.tracked_of_truth[g] >= 0) continue;
+      current.truth_of_tracked[t] = static_cast<int>(g);
+      current.tracked_of_truth[g] = static_cast<int>(t);
+      self(self, t + 1, pairs + 1, total + *distance[t][g]);
+      current.truth_of_tracked[t] = -1;
+      current.tracked_of_truth[g] = -1;
+    }
+    self(self, t + 1, pairs, total);
+  };
+  search(search, 0, 0, 0.0);
+  return best;
+}
+
+HandsScorer::HandsScorer(std::string name, const std::vector<std::optional<Handedness>>& truth_hands)
+    : last_id_(truth_hands.size(), 0) {
+  score_.name = std::move(name);
+  for (size_t k = 0; k < truth_hands.size(); ++k) {
+    SequenceScore hand;
+    hand.name = "hand " + std::to_string(k);
+    hand.expected_hand = truth_hands[k];
+    score_.hands.push_back(std::move(hand));
+  }
+}
+
+HandMatch HandsScorer::add(std::span<const TrackerOutput> tracked, std::span<const Fingertips> truth) {
+  if (truth.size() != score_.hands.size()) {
+    throw std::invalid_argument("HandsScorer::add: " + std::to_string(truth.size()) + " ground-truth hands, expected " +
+                                std::to_string(score_.hands.size()));
+  }
+  ++score_.frames;
+  for (const auto& out : tracked) {
+    if (out.state == TrackingState::kNoHand) continue;
+    if (!out.params.allFinite()) ++score_.nan_poses;
+    if (out.detection_guided_won) ++score_.guided_wins;
+  }
+  const HandMatch match = match_hands(tracked, truth);
+  int phantoms = 0;
+  for (size_t t = 0; t < tracked.size(); ++t) {
+    phantoms += tracked[t].state != TrackingState::kNoHand && match.truth_of_tracked[t] < 0 ? 1 : 0;
+  }
+  score_.phantom_frames += phantoms > 0 ? 1 : 0;
+  score_.phantom_hands += phantoms;
+  // The frame's error over all hands' annotated fingertips (SPEC.md: the mean over a frame's
+  // annotated fingertips): sum_h n_h e_h / sum_h n_h, +inf if an annotated hand was missed.
+  double tip_error_sum = 0.0;
+  int tips = 0;
+  bool missed = false;
+  for (size_t g = 0; g < truth.size(); ++g) {
+    SequenceScore& hand = score_.hands[g];
+    ++hand.frames;
+    const int t = match.tracked_of_truth[g];
+    const int annotated = static_cast<int>(std::count_if(truth[g].begin(), truth[g].end(),
+                                                         [](const auto& tip) { return tip.has_value(); }));
+    double error = std::numeric_limits<double>::quiet_NaN();
+    if (annotated > 0) error = t < 0 ? std::numeric_limits<double>::infinity() : fingertip_error_mm(tracked[static_cast<size_t>(t)], truth[g]);
+    hand.per_frame_error_mm.push_back(error);
+    if (annotated > 0 && t < 0) missed = true;
+    if (annotated > 0 && t >= 0) {
+      tip_error_sum += error * annotated;
+      tips += annotated;
+    }
+    uint32_t id = 0;
+    if (t >= 0) {
+      const TrackerOutput& out = tracked[static_cast<size_t>(t)];
+      id = out.hand_id;
+      ++hand.posed_frames;
+      hand.left_frames += out.handedness == Handedness::kLeft ? 1 : 0;
+      if (hand.expected_hand) {
+        ++hand.hand_known_frames;
+        hand.hand_correct += out.handedness == *hand.expected_hand ? 1 : 0;
+      }
+    }
+    // A swap: matched in this frame and the last, to hands of different ids.
+    if (id != 0 && last_id_[g] != 0 && id != last_id_[g]) ++hand.identity_swaps;
+    last_id_[g] = id;
+  }
+  double frame_error = std::numeric_limits<double>::quiet_NaN();
+  if (missed) {
+    frame_error = std::numeric_limits<double>::infinity();
+  } else if (tips > 0) {
+    frame_error = tip_error_sum / tips;
+  }
+  score_.per_frame_error_mm.push_back(frame_error);
+  return match;
+}
+
+SequenceScore HandsScorer::finish(double tracking_seconds) {
+  score_.posed_frames = score_.left_frames = score_.hand_known_frames = score_.hand_correct = 0;
+  score_.identity_swaps = 0;
+  for (auto& hand : score_.hands) {
+    summarise(hand);
+    hand.fps = tracking_seconds > 0.0 ? hand.frames / tracking_seconds : 0.0;
+    score_.posed_frames += hand.posed_frames;
+    score_.left_frames += hand.left_frames;
+    score_.hand_known_frames += hand.hand_known_frames;
+    score_.hand_correct += hand.hand_correct;
+    score_.identity_swaps += hand.identity_swaps;
+  }
+  summarise(score_);
+  score_.fps = tracking_seconds > 0.0 ? score_.frames / tracking_seconds : 0.0;
+  return score_;
 }
 
 std::vector<ScoreGroups> group_scores(const std::vector<SequenceScore>& sequences) {
@@ -133,6 +301,32 @@ std::string format_table(const std::vector<SequenceScore>& sequences, const Sequ
     text += "\nby " + g.by + ":\n";
     for (const auto& s : g.groups) row(s);
   }
+  // Scored per hand: a row per ground-truth hand (missed frames, the share reported on the right
+  // side, identity swaps), and the phantom hands of the sequence.
+  const bool per_hand = std::any_of(sequences.begin(), sequences.end(), [](const auto& s) { return !s.hands.empty(); });
+  if (!per_hand) return text;
+  std::snprintf(line, sizeof line, "\nper hand:\n%-22s %7s %9s %6s %6s %6s %6s %7s %7s %6s\n", "hand", "frames",
+                "mean_mm", "<15", "<20", "<25", "<30", "missed", "side_%", "swaps");
+  text += line;
+  const auto hand_rows = [&](const SequenceScore& s) {
+    if (s.hands.empty()) return;
+    for (size_t k = 0; k < s.hands.size(); ++k) {
+      const SequenceScore& h = s.hands[k];
+      const std::string label = s.name + "/" + std::to_string(k) + " " +
+                                (h.expected_hand ? to_string(*h.expected_hand) : "?");
+      const double side = h.hand_known_frames > 0 ? 100.0 * h.hand_correct / h.hand_known_frames
+                                                  : std::numeric_limits<double>::quiet_NaN();
+      std::snprintf(line, sizeof line, "%-22s %7d %9.2f %6.1f %6.1f %6.1f %6.1f %7d %7.1f %6d\n", label.c_str(),
+                    h.frames, h.mean_error_mm, h.pct_below[0], h.pct_below[1], h.pct_below[2], h.pct_below[3],
+                    h.without_pose, side, h.identity_swaps);
+      text += line;
+    }
+    std::snprintf(line, sizeof line, "  %s: %d frames with a phantom hand (%d hands)\n", s.name.c_str(),
+                  s.phantom_frames, s.phantom_hands);
+    text += line;
+  };
+  for (const auto& s : sequences) hand_rows(s);
+  hand_rows(total);
   return text;
 }
 
@@ -168,6 +362,27 @@ nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const Sequen
                           {"handedness", hands(s)},
                           {"fps", s.fps}};
   };
+  // Scored per hand: each ground-truth hand's scores, its misses and identity swaps (also per 1000
+  // of the sequence's frames), and the sequence's phantom hands. Nothing for a one-hand scoring.
+  const auto add_hands = [&](nlohmann::json& j, const SequenceScore& s) {
+    if (s.hands.empty()) return;
+    j["hands"] = nlohmann::json::array();
+    for (size_t k = 0; k < s.hands.size(); ++k) {
+      const SequenceScore& h = s.hands[k];
+      nlohmann::json hand = {{"hand", k},
+                             {"side", h.expected_hand ? nlohmann::json(to_string(*h.expected_hand)) : nlohmann::json(nullptr)},
+                             {"misses", h.without_pose},
+                             {"identity_swaps", h.identity_swaps},
+                             {"identity_swaps_per_1000_frames", h.frames > 0 ? number(1000.0 * h.identity_swaps / h.frames)
+                                                                             : nlohmann::json(nullptr)}};
+      hand.update(scores(h));
+      j["hands"].push_back(std::move(hand));
+    }
+    j["identity_swaps"] = s.identity_swaps;
+    j["phantom_frames"] = s.phantom_frames;
+    j["phantom_hands"] = s.phantom_hands;
+    j["pct_frames_with_phantom"] = s.frames > 0 ? number(100.0 * s.phantom_frames / s.frames) : nlohmann::json(nullptr);
+  };
   nlohmann::json out;
   out["sequences"] = nlohmann::json::array();
   for (const auto& s : sequences) {
@@ -175,9 +390,11 @@ nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const Sequen
     j.update(scores(s));
     if (!s.view.empty()) j["view"] = s.view;
     if (!s.motion.empty()) j["motion"] = s.motion;
+    add_hands(j, s);
     out["sequences"].push_back(std::move(j));
   }
   out["overall"] = scores(total);
+  add_hands(out["overall"], total);
   if (!groups.empty()) {
     out["groups"] = nlohmann::json::object();
     for (const auto& g : groups) {

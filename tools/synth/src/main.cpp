@@ -1,6 +1,8 @@
 // handtrack-synth: renders a synthetic depth sequence with ground truth (SPEC.md "Sequence
-// directory"): camera.json, depth/, labels/, groundtruth.csv, joints.csv, plus poses.csv (the 26
-// pose parameters of each frame) and subject.json (the subject's scales and bone lengths).
+// directory"): camera.json, depth/, labels/, groundtruth.csv, joints.csv, hand.json, plus poses.csv
+// (the 26 pose parameters of each frame) and subject.json (the subject's scales and bone lengths).
+// A two-hand motion (two_hand_motions.hpp) writes both hands' ground truth, hand 0 (right) then
+// hand 1 (left), as docs/SEQUENCES.md describes.
 
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
@@ -56,68 +58,97 @@ void prepare_output(const fs::path& dir, bool force) {
   if (!has_sequence) return;
   if (!force) throw std::runtime_error(dir.string() + " already holds a sequence (use --force to replace it)");
   for (const char* name : {"depth", "labels", "preview"}) fs::remove_all(dir / name);
-  for (const char* name : {"camera.json", "groundtruth.csv", "joints.csv", "poses.csv", "subject.json"}) {
+  for (const char* name : {"camera.json", "groundtruth.csv", "joints.csv", "poses.csv", "subject.json", "hand.json"}) {
     fs::remove(dir / name);
   }
 }
 
-void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticCamera& cam) {
-  const auto& o = cam.options();
+// Per finger: bone lengths, radii and base of one hand's shape.
+nlohmann::json fingers_json(const handtrack::synth::HandShape& shape) {
   nlohmann::json bones = nlohmann::json::object();
   for (int f = 0; f < handtrack::kNumFingers; ++f) {
-    const auto& fs_ = cam.shape().fingers[static_cast<size_t>(f)];
+    const auto& fs_ = shape.fingers[static_cast<size_t>(f)];
     bones[std::string(handtrack::kFingerNames[static_cast<size_t>(f)])] = {
         {"bone_lengths_mm", fs_.bone_length_mm}, {"radii_mm", fs_.radius_mm},
         {"base_mm", {fs_.base_mm.x(), fs_.base_mm.y(), fs_.base_mm.z()}}};
   }
+  return bones;
+}
+
+// The subject: one hand's scales and fingers at the top level; for a two-hand motion "hands", one
+// object per hand (its side, scales and fingers) in the order of the ground-truth blocks.
+void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticCamera& cam) {
+  const auto& o = cam.options();
   nlohmann::json j = {{"generator", kProgram},
                       {"motion", o.motion},
                       {"frames", o.frames},
                       {"seed", o.seed},
-                      {"length_scale", cam.subject().length},
-                      {"width_scale", cam.subject().width},
                       {"noise", o.noise},
                       {"noise_sigma_k_per_mm", o.noise_params.sigma_k_per_mm},
                       {"background", std::string(handtrack::synth::background_name(o.background))},
-                      {"hand", std::string(handtrack::synth::handedness_name(o.hand))},
-                      {"view", std::string(handtrack::synth::view_name(o.view))},
-                      {"fingers", bones},
                       {"pose_parameters", "poses.csv: frame, t_x,t_y,t_z (mm, wrist), r_x,r_y,r_z (axis-angle, "
                                           "R = exp(r) diag(1,-1,-1)), thumb..little abd,flex1,flex2,flex3 (rad)"}};
+  if (cam.hand_count() == 1) {
+    j["length_scale"] = cam.subject().length;
+    j["width_scale"] = cam.subject().width;
+    j["hand"] = std::string(handtrack::synth::handedness_name(o.hand));
+    j["view"] = std::string(handtrack::synth::view_name(o.view));
+    j["fingers"] = fingers_json(cam.shape());
+  } else {
+    j["pose_parameters"] = j["pose_parameters"].get<std::string>() +
+                           "; hand 1's columns prefixed h1_, its pose the right-hand model's whose mirror image "
+                           "(x -> -x) it is";
+    j["hands"] = nlohmann::json::array();
+    for (int k = 0; k < cam.hand_count(); ++k) {
+      j["hands"].push_back({{"hand", k == 0 ? "right" : "left"},
+                            {"length_scale", cam.subject(k).length},
+                            {"width_scale", cam.subject(k).width},
+                            {"fingers", fingers_json(cam.shape(k))}});
+    }
+  }
   std::ofstream out(file);
   if (!out) throw std::runtime_error(file.string() + ": cannot write");
   out << j.dump(1) << "\n";
 }
 
-// SPEC.md "Sequence directory": hand.json, which hand the sequence shows; ours besides: the view
-// and the motion, by which handtrack-eval groups its scores.
-void write_hand_json(const fs::path& file, const SynthOptions& o) {
-  std::ofstream out(file);
-  if (!out) throw std::runtime_error(file.string() + ": cannot write");
-  out << nlohmann::json{{"hands", {std::string(handtrack::synth::handedness_name(o.hand))}},
-                        {"view", std::string(handtrack::synth::view_name(o.view))},
-                        {"motion", o.motion}}
-             .dump()
-      << "\n";
+// SPEC.md "Sequence directory": hand.json, which hands the sequence shows; ours besides: the motion
+// and (one hand) the view, by which handtrack-eval groups its scores. A two-hand scene has its own
+// arrangement, no view.
+void write_hands(handtrack::SequenceWriter& writer, const handtrack::synth::SyntheticCamera& cam) {
+  const auto& o = cam.options();
+  if (cam.hand_count() == 1) {
+    writer.write_hands({std::string(handtrack::synth::handedness_name(o.hand))},
+                       {{"view", std::string(handtrack::synth::view_name(o.view))}, {"motion", o.motion}});
+  } else {
+    writer.write_hands({"right", "left"}, {{"motion", o.motion}});
+  }
 }
 
+// poses.csv: the frame, then per hand the 26 parameters (hand k's columns prefixed as in
+// groundtruth.csv: h1_tx, ...).
 class PosesCsv {
  public:
-  explicit PosesCsv(const fs::path& file) : file_(file), out_(file) {
+  PosesCsv(const fs::path& file, int hands) : file_(file), out_(file), hands_(hands) {
     if (!out_) throw std::runtime_error(file.string() + ": cannot write");
-    out_ << "frame,tx,ty,tz,rx,ry,rz";
-    for (auto name : handtrack::kFingerNames) {
-      for (const char* q : {"_abd", "_flex1", "_flex2", "_flex3"}) out_ << "," << name << q;
+    out_ << "frame";
+    for (int h = 0; h < hands; ++h) {
+      const std::string prefix = handtrack::hand_column_prefix(h);
+      for (const char* q : {"tx", "ty", "tz", "rx", "ry", "rz"}) out_ << "," << prefix << q;
+      for (auto name : handtrack::kFingerNames) {
+        for (const char* q : {"_abd", "_flex1", "_flex2", "_flex3"}) out_ << "," << prefix << name << q;
+      }
     }
     out_ << "\n";
   }
-  void write(int frame, const handtrack::synth::HandPose& pose) {
-    const auto p = pose.to_params();
+  void write(const handtrack::synth::SynthFrame& frame) {
     char buf[32];
-    out_ << frame;
-    for (int i = 0; i < p.size(); ++i) {
-      std::snprintf(buf, sizeof buf, ",%.6f", p(i));
-      out_ << buf;
+    out_ << frame.frame;
+    for (int h = 0; h < hands_; ++h) {
+      const auto p = frame.hands[static_cast<size_t>(h)].pose.to_params();
+      for (int i = 0; i < p.size(); ++i) {
+        std::snprintf(buf, sizeof buf, ",%.6f", p(i));
+        out_ << buf;
+      }
     }
     out_ << "\n";
     if (!out_) throw std::runtime_error(file_.string() + ": write failed");
@@ -126,7 +157,13 @@ class PosesCsv {
  private:
   fs::path file_;
   std::ofstream out_;
+  int hands_ = 1;
 };
+
+std::string motion_description(const std::string& name) {
+  const auto one = handtrack::synth::motion_description(name);
+  return std::string(one.empty() ? handtrack::synth::two_hand_motion_description(name) : one);
+}
 
 }  // namespace
 
@@ -151,7 +188,8 @@ int main(int argc, char** argv) {
   bool no_labels = false;
   app.add_flag("--list-motions", list, "List the motions and exit");
   app.add_flag("--list-views", list_views, "List the views (camera arrangements) and exit");
-  app.add_option("--motion", motion, "Motion: adbadd, fingercount, fingerwave, flexex1, pinch, random, tigergrasp");
+  app.add_option("--motion", motion, "Motion: adbadd, fingercount, fingerwave, flexex1, pinch, random, tigergrasp; "
+                                     "two hands: two_apart, two_clap, two_cross, two_pinch");
   app.add_option("--frames", frames, "Number of frames (slow first half, fast second half)")
       ->check(CLI::Range(1, 1000000));
   app.add_option("--out", out_dir, "Output sequence directory");
@@ -161,9 +199,11 @@ int main(int argc, char** argv) {
   app.add_flag("--noise,!--no-noise", options.noise, "Sensor noise model on (default) or off");
   app.add_option("--background", background,
                  "Background: body (default; head-mounted view: table), table or none");
-  app.add_option("--hand", hand, "right (default) or left: the right hand's exact mirror image");
+  app.add_option("--hand", hand, "right (default) or left: the right hand's exact mirror image (not with a "
+                                 "two-hand motion: it shows both)");
   app.add_option("--view", view, "Camera arrangement (see --list-views): palm (default), back, side, "
-                                 "fingers-toward, fingers-away, head-mounted");
+                                 "fingers-toward, fingers-away, head-mounted (not with a two-hand motion: "
+                                 "it places both hands itself)");
   app.add_option("--width", width, "Image width (intrinsics scale with it)")->check(CLI::Range(16, 4096));
   app.add_option("--height", height, "Image height (intrinsics scale with it)")->check(CLI::Range(16, 4096));
   app.add_flag("--preview", preview, "Also write preview/NNNNNN.png (depth gray | labels in colour)");
@@ -176,6 +216,9 @@ int main(int argc, char** argv) {
     for (auto name : handtrack::synth::kMotionNames) {
       std::cout << name << "\t" << handtrack::synth::motion_description(name) << "\n";
     }
+    for (auto name : handtrack::synth::kTwoHandMotionNames) {
+      std::cout << name << "\t" << handtrack::synth::two_hand_motion_description(name) << "\n";
+    }
     return 0;
   }
   if (list_views) {
@@ -186,8 +229,16 @@ int main(int argc, char** argv) {
   }
   if (motion.empty()) return fail("--motion is required (see --list-motions)");
   if (out_dir.empty()) return fail("--out is required");
-  if (handtrack::synth::motion_description(motion).empty()) {
-    return fail("unknown motion '" + motion + "' (see --list-motions)");
+  if (motion_description(motion).empty()) return fail("unknown motion '" + motion + "' (see --list-motions)");
+  if (handtrack::synth::is_two_hand_motion(motion)) {
+    // Refused rather than ignored: a left-hand or back-view sequence asked for would silently be
+    // something else.
+    for (const char* option : {"--hand", "--view"}) {
+      if (app.count(option) > 0) {
+        return fail(std::string(option) + " does not apply to the two-hand motion '" + motion +
+                    "' (it shows a right and a left hand in its own arrangement)");
+      }
+    }
   }
   const auto arrangement = handtrack::synth::parse_view(view);
   if (!arrangement) return fail("unknown view '" + view + "' (see --list-views)");
@@ -211,8 +262,8 @@ int main(int argc, char** argv) {
     prepare_output(dir, force);
     handtrack::SequenceWriter writer(dir, cam.camera());
     write_subject_json(dir / "subject.json", cam);
-    write_hand_json(dir / "hand.json", options);
-    PosesCsv poses(dir / "poses.csv");
+    write_hands(writer, cam);
+    PosesCsv poses(dir / "poses.csv", cam.hand_count());
     if (preview) fs::create_directories(dir / "preview");
 
     handtrack::tools::Progress progress(kProgram);
@@ -221,9 +272,11 @@ int main(int argc, char** argv) {
       cam.render(i, frame);
       writer.write_depth(i, frame.depth);
       if (!no_labels) writer.write_labels(i, frame.labels);
-      writer.write_fingertips(i, frame.fingertips);
-      writer.write_joints(i, frame.joints);
-      poses.write(i, frame.pose);
+      for (int h = 0; h < frame.hand_count; ++h) {
+        writer.write_fingertips(i, frame.hands[static_cast<size_t>(h)].fingertips, h);
+        writer.write_joints(i, frame.hands[static_cast<size_t>(h)].joints, h);
+      }
+      poses.write(frame);
       if (preview) handtrack::write_png_rgb(handtrack::frame_file(dir / "preview", i), preview_image(frame));
       progress.update("frames", static_cast<double>(i + 1) / frames);
     }

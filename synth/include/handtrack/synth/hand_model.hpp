@@ -112,4 +112,27 @@ Fingertips fingertips_from_joints(const Joints& joints);
 void posed_primitives(const HandShape& shape, const HandPose& pose, const Joints& camera_joints,
                       std::vector<ConeSphere>& out);
 
+// The global part of a pose: turned by `turn` = exp(r) (so camera_R_hand = turn R0) and placed so
+// that the palm centre is at `palm_centre_mm` (camera frame): r = log(turn), t = c - R palm_centre.
+// The fingers are left as they are.
+void place_palm(HandPose& pose, const HandShape& shape, const Eigen::Matrix3d& turn,
+                const Eigen::Vector3d& palm_centre_mm);
+
+// The mirror image about the camera's x = 0 plane, x -> -x: how the right-hand model shows a left
+// hand (synthetic_camera.hpp, Handedness). A mirrored cone-sphere is a cone-sphere.
+void mirror_x(Joints& joints);
+void mirror_x(std::vector<ConeSphere>& solids);
+
+// Distance (mm) between the surfaces of two cone-spheres, negative where they overlap. A
+// cone-sphere is the union of the balls B(a + s (b - a), r_a + s (r_b - r_a)), s in [0, 1] (the
+// convex hull of its end spheres), so the gap is
+//   min_{s,t in [0,1]} |p(s) - q(t)| - r(s) - r'(t),
+// a convex function of (s, t) (a norm of an affine map minus affine terms), minimised here by
+// nested golden-section searches to ~1e-3 mm. Where they overlap the value is minus the deepest
+// overlap of two of those balls.
+double surface_gap_mm(const ConeSphere& a, const ConeSphere& b);
+// The smallest gap between any solid of `a` and any of `b` (e.g. two hands, to check that they
+// touch but never pass through each other).
+double surface_gap_mm(const std::vector<ConeSphere>& a, const std::vector<ConeSphere>& b);
+
 }  // namespace handtrack::synth

@@ -20,6 +20,11 @@ inline constexpr double kSpeedRampSeconds = 0.3;  // the speed changes smoothly 
 // One-line description of a motion for --list-motions ("" for an unknown name).
 std::string_view motion_description(std::string_view name);
 
+// The warped "motion time" in seconds of frame i of a sequence of `frames` at `fps`: speed 1 in the
+// first half, kFastSpeedFactor in the second (a smoothstep ramp of kSpeedRampSeconds between), and
+// beyond the end back and forth (frames 0..N-1, N-2..1, 0..N-1, ...). Every motion's clock.
+double warped_motion_time(int frame, int frames, double fps);
+
 class Motion {
  public:
   // Throws std::invalid_argument for an unknown name or frames < 1 or fps <= 0. The pinch pose is
@@ -29,6 +34,9 @@ class Motion {
   // Pose of frame i (any i >= 0; beyond the sequence the motion plays back and forth, so the pose
   // stays continuous for an endless live camera).
   [[nodiscard]] HandPose pose(int frame) const;
+  // Pose at a motion time (seconds; pose(i) = pose_at(motion_time(i))): a motion sampled with a
+  // time offset (two_hand_motions.hpp: one hand lagging the other).
+  [[nodiscard]] HandPose pose_at(double motion_time) const;
   // Warped "motion time" in seconds at frame i (speeds up by kFastSpeedFactor in the second half).
   [[nodiscard]] double motion_time(int frame) const;
   [[nodiscard]] std::string_view name() const { return kMotionNames[static_cast<size_t>(index_)]; }

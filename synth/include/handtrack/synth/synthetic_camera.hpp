@@ -1,7 +1,8 @@
 #pragma once
 // SyntheticCamera: renders depth frames with ground truth of a capsule hand performing one of the
-// Dexter 1 motions, with an optional sensor noise model and background. Used by handtrack-synth
-// (sequence directories) and by the daemon's `synthetic[:MOTION]` live source.
+// Dexter 1 motions, or of two hands in one of the two-hand scenes (two_hand_motions.hpp), with an
+// optional sensor noise model and background. Used by handtrack-synth (sequence directories) and by
+// the daemon's `synthetic[:MOTION]` live source.
 //
 //   SyntheticCamera cam(SynthOptions{.motion = "pinch", .frames = 300});
 //   SynthFrame f;
@@ -16,8 +17,10 @@
 #include "handtrack/synth/hand_model.hpp"
 #include "handtrack/synth/motions.hpp"
 #include "handtrack/synth/noise.hpp"
+#include "handtrack/synth/two_hand_motions.hpp"
 #include "handtrack/synth/views.hpp"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -48,10 +51,14 @@ std::optional<Handedness> parse_handedness(std::string_view name);
 CameraIntrinsics default_camera(int width = 320, int height = 240);
 
 struct SynthOptions {
-  std::string motion = "flexex1";       // one of kMotionNames
+  // One of kMotionNames, or of kTwoHandMotionNames: a right and a left hand (then `hand` must stay
+  // kRight and `view` kPalm: the scene places both hands itself).
+  std::string motion = "flexex1";
   int frames = 300;                     // sequence length: slow first half, fast second half
   uint64_t seed = 1;                    // subject (when not given), noise
-  std::optional<SubjectScale> subject;  // nullopt: length and width scale drawn from the seed in [0.9, 1.1]
+  // nullopt: length and width scale drawn from the seed in [0.9, 1.1], for each hand of a two-hand
+  // motion its own; given: every hand's.
+  std::optional<SubjectScale> subject;
   bool noise = true;
   Background background = Background::kBody;
   CameraIntrinsics camera = default_camera();
@@ -65,13 +72,28 @@ struct SynthOptions {
 // `fps`. Tests render the daemon's frames (and their ground truth) with the same options.
 SynthOptions live_camera_options(const std::string& motion, int frames, uint64_t seed, int fps);
 
+// The ground truth of one hand in a frame.
+struct SynthHand {
+  Handedness hand = Handedness::kRight;
+  HandPose pose;          // the right-hand model's pose (a left hand shows its mirror image)
+  Joints joints;          // 21 joints, mm, camera frame (TIP = tip-sphere centre)
+  Fingertips fingertips;  // the 5 TIP joints, all present
+};
+
 struct SynthFrame {
   int frame = 0;
+  // pose, joints and fingertips: hand 0's (the only hand of a one-hand motion).
   HandPose pose;         // the right-hand model's pose (a left hand shows its mirror image)
   DepthImage depth;      // mm, 0 = no measurement (noisy when options.noise)
-  Gray8Image labels;     // part labels of hand_layout.hpp; 0 = background, forearm, or no depth
+  Gray8Image labels;     // part labels of hand_layout.hpp (every hand's 1..12); 0 = background, forearm, or no depth
   Joints joints;         // 21 joints, mm, camera frame (TIP = tip-sphere centre)
   Fingertips fingertips;  // the 5 TIP joints, all present
+  // Every hand: hands[0 .. hand_count). A two-hand motion: hands[0] right, hands[1] left.
+  int hand_count = 1;
+  std::array<SynthHand, kTwoHands> hands{};
+  // Two-hand motions: which hand each pixel shows, 0 = none (background, no depth), k + 1 =
+  // hands[k] (its forearm too). Empty (0 x 0) for one-hand motions.
+  Gray8Image hand_index;
 };
 
 class SyntheticCamera {
@@ -91,17 +113,19 @@ class SyntheticCamera {
   [[nodiscard]] SynthFrame render(int frame);
   // Renders an arbitrary pose (e.g. a random one within JointLimits, for training the part forest)
   // with this camera's subject, background and noise; `frame` only seeds the noise. out.frame =
-  // frame, out.pose = pose.
+  // frame, out.pose = pose. One-hand motions only (std::logic_error otherwise).
   void render_pose(const HandPose& pose, int frame, SynthFrame& out);
 
-  // The pose of frame i (the motion's, seen in options.view; the right-hand model's for a left
-  // hand too): no image, cheap.
-  [[nodiscard]] HandPose pose(int frame) const;
+  // The pose of hand `hand` in frame i (the motion's, seen in options.view; the right-hand model's
+  // for a left hand too): no image, cheap.
+  [[nodiscard]] HandPose pose(int frame, int hand = 0) const;
 
-  [[nodiscard]] const SynthOptions& options() const;
+  // 1, or 2 for a two-hand motion.
+  [[nodiscard]] int hand_count() const;
+  [[nodiscard]] const SynthOptions& options() const;  // options().subject: hand 0's
   [[nodiscard]] const CameraIntrinsics& camera() const;
-  [[nodiscard]] const SubjectScale& subject() const;
-  [[nodiscard]] const HandShape& shape() const;
+  [[nodiscard]] const SubjectScale& subject(int hand = 0) const;
+  [[nodiscard]] const HandShape& shape(int hand = 0) const;
 
  private:
   struct State;
