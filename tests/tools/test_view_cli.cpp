@@ -1,7 +1,10 @@
 // handtrack-view end to end: it renders a sequence frame (from handtrack-synth when that program is
 // built, otherwise from a sequence written here) and a single depth PNG to a valid PNG with one
 // panel per view, and it fails cleanly (exit 1, one line on stderr naming the problem) on a
-// missing file, a corrupt PNG, a bad camera.json and a frame out of range.
+// missing file, a corrupt PNG, a bad camera.json and a frame out of range. Of a two-hand sequence
+// it draws both fitted hands, each in its own colour, and with --max-hands 1 only one.
+#include "hand_colours.hpp"  // tools/view/src
+
 #include "handtrack/core/camera.hpp"
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/sequence.hpp"
@@ -11,6 +14,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -47,6 +51,49 @@ std::optional<PngSize> read_png_size(const fs::path& file) {
   png_image_free(&png);
   if (!ok) return std::nullopt;
   return size;
+}
+
+struct RgbPng {
+  int width = 0;
+  int height = 0;
+  std::vector<uint8_t> pixels;  // RGB, row after row
+  [[nodiscard]] draw::Rgb at(int x, int y) const {
+    const size_t i = 3 * (static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x));
+    return {pixels[i], pixels[i + 1], pixels[i + 2]};
+  }
+};
+
+std::optional<RgbPng> read_png_rgb(const fs::path& file) {
+  png_image png;
+  std::memset(&png, 0, sizeof png);
+  png.version = PNG_IMAGE_VERSION;
+  if (png_image_begin_read_from_file(&png, file.c_str()) == 0) return std::nullopt;
+  png.format = PNG_FORMAT_RGB;
+  RgbPng out{static_cast<int>(png.width), static_cast<int>(png.height), std::vector<uint8_t>(PNG_IMAGE_SIZE(png))};
+  const bool ok = png_image_finish_read(&png, nullptr, out.pixels.data(), 0, nullptr) != 0;
+  png_image_free(&png);
+  if (!ok) return std::nullopt;
+  return out;
+}
+
+// Whether `pixel` is `colour` as handtrack-view draws a hand in it: the colour itself, blended over
+// the gray depth, or shaded toward black or white. All of these keep the colour's chroma (its
+// difference from its own gray level) up to a positive factor, so the two chroma vectors point the
+// same way; gray, and the other colours of the panel (the other hand's, the ground-truth cyan), do
+// not.
+bool of_colour(draw::Rgb pixel, draw::Rgb colour) {
+  const auto chroma = [](draw::Rgb c) {
+    const double mean = (c.r + c.g + c.b) / 3.0;
+    return std::array<double, 3>{c.r - mean, c.g - mean, c.b - mean};
+  };
+  const auto p = chroma(pixel);
+  const auto c = chroma(colour);
+  const double dot = p[0] * c[0] + p[1] * c[1] + p[2] * c[2];
+  const double p_norm = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+  const double c_norm = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+  constexpr double kMinChroma = 30.0;  // below: near gray, the hue is noise (8-bit rounding)
+  constexpr double kMinCosine = 0.97;  // about 14 degrees between the chroma vectors
+  return p_norm >= kMinChroma && dot >= kMinCosine * p_norm * c_norm;
 }
 
 int count_lines(const std::string& text) {
@@ -258,6 +305,75 @@ TEST_F(ViewCli, UsageErrorsAreOneLine) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(count_lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("--fx"), std::string::npos) << r.err;
+}
+
+// Two hands side by side (handtrack-synth's two_apart: the palms ~200 mm apart, one in each half
+// of the image): the model panel shows both fitted models, each in its own colour, one in the left
+// half and the other in the right; with --max-hands 1 it shows one hand only.
+TEST_F(ViewCli, DrawsBothHandsOfATwoHandSequence) {
+#ifndef HANDTRACK_VIEW_SYNTH_EXE
+  GTEST_SKIP() << "needs handtrack-synth for a two-hand sequence";
+#else
+  const fs::path seq = dir_ / "two";
+  const ProcessResult synth =
+      run(HANDTRACK_VIEW_SYNTH_EXE, "--motion two_apart --frames 30 --out '" + seq.string() + "'");
+  ASSERT_EQ(synth.exit_code, 0) << synth.err;
+  ASSERT_EQ(SequenceReader(seq).hand_count(), 2);
+  const int image_width = SequenceReader(seq).camera().width;
+
+  // Pixels of each hand's colour in the left and the right half of the model panel (c), the third
+  // of four (depth, quadtree, model, labels), each as wide as the image, with equal gaps.
+  struct Halves {
+    std::array<int, view::kHandColours.size()> left{};
+    std::array<int, view::kHandColours.size()> right{};
+  };
+  const auto model_panel_halves = [&](const std::string& extra_args) {
+    const fs::path out = dir_ / "two.png";
+    const ProcessResult r =
+        view("--seq '" + seq.string() + "' --frame 29 " + extra_args + " --out '" + out.string() + "'");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    const auto png = read_png_rgb(out);
+    Halves h;
+    if (!png) {
+      ADD_FAILURE() << "not a valid PNG: " << out;
+      return h;
+    }
+    const int gaps = png->width - 4 * image_width;
+    EXPECT_TRUE(gaps > 0 && gaps % 5 == 0) << "not four panels of " << image_width << " px: " << png->width;
+    const int gap = gaps / 5;
+    const int x0 = gap + 2 * (image_width + gap);
+    for (int y = 0; y < png->height; ++y) {
+      for (int x = x0; x < x0 + image_width; ++x) {
+        for (size_t k = 0; k < view::kHandColours.size(); ++k) {
+          if (!of_colour(png->at(x, y), view::kHandColours[k])) continue;
+          ++(x < x0 + image_width / 2 ? h.left : h.right)[k];
+        }
+      }
+    }
+    return h;
+  };
+  // A fitted hand is ~3000 px of its colour here, measured: its model's Gaussians ~1550, skeleton and
+  // fingertips ~1050, the outline of its segmented pixels and its label ~400 (so without the model
+  // ~1450). It is drawn in a half when its colour has more than kDrawnPx pixels there and the other
+  // half less than a tenth of that.
+  constexpr int kDrawnPx = 2000;
+  const auto drawn_in = [](const Halves& h, size_t k) {
+    if (h.left[k] > kDrawnPx && h.right[k] * 10 < h.left[k]) return -1;
+    if (h.right[k] > kDrawnPx && h.left[k] * 10 < h.right[k]) return +1;
+    return 0;
+  };
+
+  const Halves two = model_panel_halves("");  // --max-hands 2, the default
+  EXPECT_NE(drawn_in(two, 0), 0) << "hand colour 0: left " << two.left[0] << " px, right " << two.right[0] << " px";
+  EXPECT_NE(drawn_in(two, 1), 0) << "hand colour 1: left " << two.left[1] << " px, right " << two.right[1] << " px";
+  EXPECT_EQ(drawn_in(two, 0), -drawn_in(two, 1)) << "the two hands are not in opposite halves";
+
+  // One hand, by part colours: neither hand colour as a whole hand in a half of its own.
+  const Halves one = model_panel_halves("--max-hands 1");
+  EXPECT_FALSE(drawn_in(one, 0) != 0 && drawn_in(one, 0) == -drawn_in(one, 1))
+      << "--max-hands 1 drew two hands: " << one.left[0] << "/" << one.right[0] << ", " << one.left[1] << "/"
+      << one.right[1];
+#endif
 }
 
 }  // namespace

@@ -1,11 +1,12 @@
 // handtrack-view: renders what the tracker sees and fits in one frame to a PNG (see --help).
 #include "render.hpp"
+#include "tracked_hands.hpp"
 
 #include "handtrack/core/camera.hpp"
+#include "handtrack/core/hands_tracker.hpp"
 #include "handtrack/core/part_forest.hpp"
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/sequence.hpp"
-#include "handtrack/core/tracker.hpp"
 #include "handtrack/common/cli.hpp"
 
 #include <CLI/CLI.hpp>
@@ -48,6 +49,7 @@ struct Args {
   std::optional<double> fx, fy, cx, cy, depth_scale;
   std::string out;
   std::optional<int> iterations, init_iterations, particles;
+  int max_hands = handtrack::TrackerConfig{}.max_hands;  // handtrackd's default (tracker.max_hands)
   std::optional<double> near_mm, far_mm;
   bool crop = false;
   int panel_height = 0;
@@ -55,16 +57,9 @@ struct Args {
   std::string forest;
 };
 
-// What the tracker segmented for the hand it reports, in the frame's own image (a left hand's
-// input is of the mirrored frame).
-handtrack::DepthInput tracker_input(const handtrack::Tracker& tracker, const handtrack::TrackerOutput& output) {
-  const handtrack::DepthInput* input = tracker.last_input();
-  if (input == nullptr) throw std::runtime_error("the tracker preprocessed no input for the hand it reports");
-  return output.handedness == handtrack::Handedness::kLeft ? handtrack::view::unmirrored(*input) : *input;
-}
-
 handtrack::TrackerConfig tracker_config(const Args& a) {
   handtrack::TrackerConfig config;
+  config.max_hands = a.max_hands;
   if (a.iterations) config.optimizer.iterations = *a.iterations;
   if (a.init_iterations) config.init_iterations = *a.init_iterations;
   if (a.particles) config.particles = *a.particles;
@@ -141,29 +136,29 @@ int run_sequence(const Args& a) {
                              std::to_string(count) + " frames, 0.." + std::to_string(count - 1) + ")");
   }
   const size_t last = a.frame ? static_cast<size_t>(*a.frame) : count - 1;
-  handtrack::Tracker tracker(tracker_config(a));
+  handtrack::HandsTracker tracker(tracker_config(a));
   const auto forest = load_forest(a);
   Progress progress(last + 1);
   int written = 0;
   for (size_t i = 0; i <= last; ++i) {
     const handtrack::DepthImage depth = reader.depth(i);
-    const handtrack::TrackerOutput output = tracker.track(depth, labeller(forest));
+    const handtrack::HandsOutput output = tracker.track(depth, labeller(forest));
     progress.step(i + 1);
     const bool wanted = a.every > 0 ? i % static_cast<size_t>(a.every) == 0 || (a.frame && i == last) : i == last;
     if (!wanted) continue;
     const auto labels = reader.labels(i);
-    const handtrack::Fingertips tips = reader.fingertips(i);
-    const bool annotated = std::any_of(tips.begin(), tips.end(), [](const auto& t) { return t.has_value(); });
     handtrack::view::FrameView view;
     view.depth = &depth;
-    const auto input = tracker_input(tracker, output);
-    view.input = &input;
-    view.mirrored_model = output.handedness == handtrack::Handedness::kLeft;
-    view.output = &output;
-    view.model = &tracker.pose_tracker().model();
+    const auto hands = handtrack::view::tracked_hands(tracker, output);
+    view.hands = handtrack::view::hand_views(hands);
     view.labels = labels ? &*labels : nullptr;
     view.labels_caption = "labels (sequence)";
-    view.truth_tips = annotated ? &tips : nullptr;
+    for (int h = 0; h < reader.hand_count(); ++h) {  // every ground-truth hand annotated in this frame
+      const handtrack::Fingertips tips = reader.fingertips(i, h);
+      if (std::any_of(tips.begin(), tips.end(), [](const auto& t) { return t.has_value(); })) {
+        view.truth_tips.push_back(tips);
+      }
+    }
     view.name = fs::path(a.seq).filename().string() + " frame " + std::to_string(reader.frame_number(i));
     const fs::path file = a.every > 0 ? numbered(a.out, reader.frame_number(i)) : fs::path(a.out);
     handtrack::write_png_rgb(file, handtrack::view::render_frame(view, render_options(a)));
@@ -218,16 +213,13 @@ int run_single(const Args& a) {
     }
   }
   // One frame: the tracker's (re)start path, the open hand placed at the segmented hand.
-  handtrack::Tracker tracker(tracker_config(a));
+  handtrack::HandsTracker tracker(tracker_config(a));
   const auto forest = load_forest(a);
-  const handtrack::TrackerOutput output = tracker.track(depth, labeller(forest));
+  const handtrack::HandsOutput output = tracker.track(depth, labeller(forest));
   handtrack::view::FrameView view;
   view.depth = &depth;
-  const auto input = tracker_input(tracker, output);
-  view.input = &input;
-  view.mirrored_model = output.handedness == handtrack::Handedness::kLeft;
-  view.output = &output;
-  view.model = &tracker.pose_tracker().model();
+  const auto hands = handtrack::view::tracked_hands(tracker, output);
+  view.hands = handtrack::view::hand_views(hands);
   view.labels = labels ? &*labels : nullptr;
   view.labels_caption = "labels " + fs::path(a.labels).filename().string();
   view.name = fs::path(a.depth).filename().string();
@@ -241,6 +233,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Render a depth frame to PNG: (a) depth with the segmented hand tinted green, (b) the quadtree image "
       "Gaussians, (c) the fitted hand model (Gaussians by part, skeleton, fingertips), (d) part labels if any.\n"
+      "Two hands (--max-hands 2, the default): each hand's pixels, model and fingertips in a colour of its own "
+      "(orange, violet), labelled '#id side confidence' by the hand; ground-truth fingertips of every hand.\n"
       "A sequence frame is tracked from frame 0 on, so its pose is a tracked one; a single --depth frame "
       "is fitted from scratch (the tracker's start path).",
       kProgram};
@@ -265,6 +259,10 @@ int main(int argc, char** argv) {
                  "Iterations of each (re)start hypothesis, e.g. for a single frame (default 80)")
       ->check(CLI::Range(1, 10000));
   app.add_option("--particles", a.particles, "Pose particles per frame (default 2)")->check(CLI::Range(1, 64));
+  app.add_option("--max-hands", a.max_hands,
+                 "Hands to track at once, 1 or 2 (default 2, as handtrackd's tracker.max_hands); 1 draws the "
+                 "frame as a single-hand tracker sees it")
+      ->check(CLI::Range(1, handtrack::kMaxHands));
   app.add_option("--near-mm", a.near_mm, "Near end of the working volume, mm (default 150)")
       ->check(CLI::Range(1.0, 10000.0));
   app.add_option("--far-mm", a.far_mm, "Far end of the working volume, mm (default 600)")

@@ -1,4 +1,8 @@
+// handtrack-view's picture of a frame: the panels side by side (the model panel: model_panel.cpp).
 #include "render.hpp"
+
+#include "hand_colours.hpp"
+#include "panel.hpp"
 
 #include "handtrack/core/kinematics.hpp"
 #include "handtrack/draw/canvas.hpp"
@@ -7,7 +11,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <numeric>
 #include <stdexcept>
 #include <vector>
 
@@ -22,10 +25,15 @@ constexpr double kCropMarginFraction = 0.3;  // of the hand's larger bounding-bo
 constexpr int kPanelGapPx = 4;
 constexpr Rgb kFrameBackground{20, 20, 20};
 constexpr Rgb kCaptionText{235, 235, 235};
-constexpr Rgb kMaskTint{40, 220, 90};
 constexpr double kMaskAlpha = 0.45;
-constexpr double kModelAlpha = 0.6;
 constexpr double kSkeletonFingerAxisMm = 60.0;  // length of the drawn finger-axis estimate
+
+bool in_mask(const DepthInput& in, int u, int v) {
+  if (u < 0 || v < 0 || u >= in.camera.width || v >= in.camera.height) return false;
+  return in.hand_mask[static_cast<size_t>(v) * static_cast<size_t>(in.camera.width) + static_cast<size_t>(u)] != 0;
+}
+
+}  // namespace
 
 std::string format(const char* fmt, double v) {
   char buf[96];
@@ -33,32 +41,66 @@ std::string format(const char* fmt, double v) {
   return buf;
 }
 
-// Maps image pixels (centres at integers) onto a panel: the region starting at (u0, v0) scaled by s.
-struct ViewMap {
-  double u0 = 0.0;
-  double v0 = 0.0;
-  double s = 1.0;
-  int width = 0;
-  int height = 0;
-  [[nodiscard]] double x(double u) const { return (u - u0 + 0.5) * s - 0.5; }
-  [[nodiscard]] double y(double v) const { return (v - v0 + 0.5) * s - 0.5; }
-  [[nodiscard]] int u_of(int x_px) const { return static_cast<int>(std::floor((x_px + 0.5) / s + u0)); }
-  [[nodiscard]] int v_of(int y_px) const { return static_cast<int>(std::floor((y_px + 0.5) / s + v0)); }
-};
+int caption_scale(int panel_width) { return panel_width >= 560 ? 2 : 1; }
 
-ViewMap make_view(const DepthInput& input, const RenderOptions& options) {
-  const int w = input.camera.width;
-  const int h = input.camera.height;
+void draw_depth(Canvas& c, const ViewMap& view, const DepthImage& depth, std::pair<double, double> range,
+                double dim) {
+  for (int y = 0; y < view.height; ++y) {
+    const int v = view.v_of(y);
+    for (int x = 0; x < view.width; ++x) {
+      const int u = view.u_of(x);
+      if (u < 0 || v < 0 || u >= depth.width() || v >= depth.height()) continue;
+      const Rgb g = draw::depth_gray(depth.at(u, v), range.first, range.second);
+      c.set_pixel(x, y, dim < 1.0 ? draw::shade(g, dim) : g);
+    }
+  }
+}
+
+void draw_mask_outline(Canvas& c, const ViewMap& view, const DepthInput& in, Rgb colour) {
+  for (int y = 0; y < view.height; ++y) {
+    for (int x = 0; x < view.width; ++x) {
+      if (!in_mask(in, view.u_of(x), view.v_of(y))) continue;
+      const bool edge = !in_mask(in, view.u_of(x - 1), view.v_of(y)) || !in_mask(in, view.u_of(x + 1), view.v_of(y)) ||
+                        !in_mask(in, view.u_of(x), view.v_of(y - 1)) || !in_mask(in, view.u_of(x), view.v_of(y + 1));
+      if (edge) c.set_pixel(x, y, colour);
+    }
+  }
+}
+
+Rgb HandStyle::mask_outline() const { return by_part ? kMaskTint : draw::shade(colour, kLighter); }
+Rgb HandStyle::part(int label) const { return by_part ? draw::part_colour(label) : colour; }
+Rgb HandStyle::bone() const { return by_part ? draw::colours::kWhite : draw::shade(colour, kLighter); }
+Rgb HandStyle::tip(int finger) const { return by_part ? draw::part_colour(part_label(finger, 2)) : colour; }
+
+HandStyle style_of(const FrameView& f, const HandView& h) {
+  if (f.hands.size() <= 1) return {};
+  return {false, kHandColours[static_cast<size_t>(std::clamp(h.slot, 0, kMaxHands - 1))]};
+}
+
+namespace {
+
+// The hands' inputs: each hand's preprocessing (the first's camera is the frame's).
+std::vector<const DepthInput*> inputs_of(const FrameView& f) {
+  std::vector<const DepthInput*> inputs;
+  for (const HandView& h : f.hands) inputs.push_back(h.input);
+  return inputs;
+}
+
+ViewMap make_view(const DepthImage& depth, const std::vector<const DepthInput*>& inputs, const RenderOptions& options) {
+  const int w = depth.width();
+  const int h = depth.height();
   ViewMap view;
   int lo_u = w, lo_v = h, hi_u = -1, hi_v = -1;
-  if (options.crop) {
-    for (int v = 0; v < h; ++v) {
-      for (int u = 0; u < w; ++u) {
-        if (input.hand_mask[static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u)] == 0) continue;
-        lo_u = std::min(lo_u, u);
-        hi_u = std::max(hi_u, u);
-        lo_v = std::min(lo_v, v);
-        hi_v = std::max(hi_v, v);
+  if (options.crop) {  // onto every hand's segmented pixels
+    for (const DepthInput* input : inputs) {
+      for (int v = 0; v < h; ++v) {
+        for (int u = 0; u < w; ++u) {
+          if (input->hand_mask[static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u)] == 0) continue;
+          lo_u = std::min(lo_u, u);
+          hi_u = std::max(hi_u, u);
+          lo_v = std::min(lo_v, v);
+          hi_v = std::max(hi_v, v);
+        }
       }
     }
   }
@@ -95,55 +137,21 @@ std::pair<double, double> depth_range(const std::vector<float>& depth_mm) {
   return {near, std::max(far, near + 1.0)};
 }
 
-// The depth image in gray (near = bright) through the view; `dim` < 1 darkens it.
-void draw_depth(Canvas& c, const ViewMap& view, const DepthImage& depth, std::pair<double, double> range,
-                double dim = 1.0) {
-  for (int y = 0; y < view.height; ++y) {
-    const int v = view.v_of(y);
-    for (int x = 0; x < view.width; ++x) {
-      const int u = view.u_of(x);
-      if (u < 0 || v < 0 || u >= depth.width() || v >= depth.height()) continue;
-      const Rgb g = draw::depth_gray(depth.at(u, v), range.first, range.second);
-      c.set_pixel(x, y, dim < 1.0 ? draw::shade(g, dim) : g);
-    }
-  }
-}
-
-bool in_mask(const DepthInput& in, int u, int v) {
-  if (u < 0 || v < 0 || u >= in.camera.width || v >= in.camera.height) return false;
-  return in.hand_mask[static_cast<size_t>(v) * static_cast<size_t>(in.camera.width) + static_cast<size_t>(u)] != 0;
-}
-
-// The outline of the segmented hand: panel pixels inside the mask with a neighbour outside, so the
-// fitted model can be judged against the hand it was fitted to.
-void draw_mask_outline(Canvas& c, const ViewMap& view, const DepthInput& in) {
-  for (int y = 0; y < view.height; ++y) {
-    for (int x = 0; x < view.width; ++x) {
-      if (!in_mask(in, view.u_of(x), view.v_of(y))) continue;
-      const bool edge = !in_mask(in, view.u_of(x - 1), view.v_of(y)) || !in_mask(in, view.u_of(x + 1), view.v_of(y)) ||
-                        !in_mask(in, view.u_of(x), view.v_of(y - 1)) || !in_mask(in, view.u_of(x), view.v_of(y + 1));
-      if (edge) c.set_pixel(x, y, kMaskTint);
-    }
-  }
-}
-
-struct Panel {
-  Canvas canvas;
-  std::string caption;
-};
-
-int caption_scale(int panel_width) { return panel_width >= 560 ? 2 : 1; }
-
 Panel depth_panel(const FrameView& f, const ViewMap& view, std::pair<double, double> range) {
   Canvas c(view.width, view.height, draw::colours::kBlack);
   draw_depth(c, view, *f.depth, range);
-  const DepthInput& in = *f.input;
-  for (int y = 0; y < view.height; ++y) {
-    for (int x = 0; x < view.width; ++x) {
-      if (in_mask(in, view.u_of(x), view.v_of(y))) c.blend_pixel(x, y, kMaskTint, kMaskAlpha);
+  for (const HandView& h : f.hands) {
+    const DepthInput& in = *h.input;
+    const Rgb tint = style_of(f, h).mask();
+    for (int y = 0; y < view.height; ++y) {
+      for (int x = 0; x < view.width; ++x) {
+        if (in_mask(in, view.u_of(x), view.v_of(y))) c.blend_pixel(x, y, tint, kMaskAlpha);
+      }
     }
   }
-  if (in.has_hand() && in.palm_centre_mm.z() > 1.0) {
+  for (const HandView& h : f.hands) {
+    const DepthInput& in = *h.input;
+    if (!in.has_hand() || !(in.palm_centre_mm.z() > 1.0)) continue;
     // The preprocessing's palm centre and wrist-to-fingers axis, as a cross and a line.
     const auto palm = in.camera.project(in.palm_centre_mm);
     const auto tip = in.camera.project(in.palm_centre_mm + kSkeletonFingerAxisMm * in.finger_axis);
@@ -153,15 +161,24 @@ Panel depth_panel(const FrameView& f, const ViewMap& view, std::pair<double, dou
     c.line(px, py, view.x(tip.x()), view.y(tip.y()), draw::colours::kYellow);
   }
   Panel p{std::move(c), {}};
-  p.caption = f.name + "\ndepth " + format("%.0f", range.first) + format("-%.0f mm", range.second) +
-              format(", hand %.0f px", in.hand_pixels);
+  p.caption = f.name + "\ndepth " + format("%.0f", range.first) + format("-%.0f mm", range.second);
+  if (f.hands.size() <= 1) {
+    p.caption += format(", hand %.0f px", f.hands.empty() ? 0.0 : f.hands.front().input->hand_pixels);
+  } else {
+    p.caption += ", hands";
+    for (size_t k = 0; k < f.hands.size(); ++k) {
+      p.caption += format(k == 0 ? " %.0f" : " + %.0f", f.hands[k].input->hand_pixels);
+    }
+    p.caption += " px";
+  }
   return p;
 }
 
 Panel quadtree_panel(const FrameView& f, const ViewMap& view, std::pair<double, double> range) {
   Canvas c(view.width, view.height, draw::colours::kBlack);
   draw_depth(c, view, *f.depth, range, 0.3);
-  const auto& gs = f.input->gaussians;
+  std::vector<ImageGaussian> gs;  // every hand's
+  for (const HandView& h : f.hands) gs.insert(gs.end(), h.input->gaussians.begin(), h.input->gaussians.end());
   const bool labelled = std::any_of(gs.begin(), gs.end(), [](const ImageGaussian& g) { return g.label != 0; });
   double near = 1e9, far = -1e9;
   for (const auto& g : gs) {
@@ -190,79 +207,6 @@ Panel quadtree_panel(const FrameView& f, const ViewMap& view, std::pair<double, 
   }
   return p;
 }
-
-Panel model_panel(const FrameView& f, const ViewMap& view, std::pair<double, double> range) {
-  Canvas c(view.width, view.height, draw::colours::kBlack);
-  draw_depth(c, view, *f.depth, range, 0.55);
-  const TrackerOutput& out = *f.output;
-  const CameraIntrinsics& cam = f.input->camera;
-  draw_mask_outline(c, view, *f.input);
-  const bool posed = out.state != TrackingState::kNoHand && out.params.allFinite();
-  if (posed) {
-    const PosedHand hand(*f.model, out.params);
-    // Scaled orthographic projection of Sec. 3.2: centre projected, sigma_p = sigma_h f / z.
-    std::vector<int> order(static_cast<size_t>(hand.gaussian_count()));
-    std::iota(order.begin(), order.end(), 0);
-    std::sort(order.begin(), order.end(), [&hand](int a, int b) { return hand.centre(a).z() > hand.centre(b).z(); });
-    const auto& model_gaussians = f.model->gaussians();
-    for (int i : order) {
-      Eigen::Vector3d p = hand.centre(i);
-      if (f.mirrored_model) p.x() = -p.x();
-      if (!(p.z() > 1.0)) continue;
-      const auto& mg = model_gaussians[static_cast<size_t>(i)];
-      const auto uv = cam.project(p);
-      const double r = mg.sigma_mm * cam.focal() / p.z() * view.s;
-      const Rgb colour = draw::part_colour(mg.label);
-      c.fill_circle(view.x(uv.x()), view.y(uv.y()), r, colour, kModelAlpha);
-      c.circle(view.x(uv.x()), view.y(uv.y()), r, draw::shade(colour, 0.5));
-    }
-    const auto to_panel = [&](const Eigen::Vector3d& p) {
-      const auto uv = cam.project(p);
-      return Eigen::Vector2d(view.x(uv.x()), view.y(uv.y()));
-    };
-    const int thick = view.width >= 560 ? 3 : 2;
-    const Eigen::Vector2d wrist = to_panel(out.joints[kWristJoint]);
-    for (int finger = 0; finger < kNumFingers; ++finger) {
-      Eigen::Vector2d prev = wrist;
-      for (int k = 0; k < 4; ++k) {
-        const Eigen::Vector2d q = to_panel(out.joints[static_cast<size_t>(joint_index(finger, k))]);
-        c.line(prev.x(), prev.y(), q.x(), q.y(), draw::colours::kWhite, thick);
-        prev = q;
-      }
-    }
-    for (const auto& j : out.joints) {
-      const Eigen::Vector2d q = to_panel(j);
-      c.fill_circle(q.x(), q.y(), thick, draw::colours::kWhite);
-    }
-    for (int finger = 0; finger < kNumFingers; ++finger) {
-      const Eigen::Vector2d q = to_panel(out.fingertips[static_cast<size_t>(finger)]);
-      c.fill_circle(q.x(), q.y(), 2.0 * thick, draw::part_colour(part_label(finger, 2)));
-      c.circle(q.x(), q.y(), 2.0 * thick, draw::colours::kBlack);
-    }
-  }
-  if (f.truth_tips != nullptr) {  // annotated fingertips: cyan crosses
-    for (const auto& tip : *f.truth_tips) {
-      if (!tip || !(tip->z() > 1.0)) continue;
-      const auto uv = cam.project(*tip);
-      const double x = view.x(uv.x()), y = view.y(uv.y());
-      c.line(x - 5, y - 5, x + 5, y + 5, Rgb{0, 230, 255}, 2);
-      c.line(x - 5, y + 5, x + 5, y - 5, Rgb{0, 230, 255}, 2);
-    }
-  }
-  Panel p{std::move(c), {}};
-  p.caption = std::string("model: ") + to_string(out.state);
-  if (posed) {
-    p.caption += std::string(", ") + to_string(out.handedness) + " hand" + format("  conf %.2f", out.confidence) +
-                 format("  E %.3g", out.energy);
-  }
-  if (f.truth_tips != nullptr) {
-    if (const auto err = fingertip_error_mm(out, *f.truth_tips); err && posed) {
-      p.caption += format("\ntip error %.1f mm (x = truth)", *err);
-    }
-  }
-  return p;
-}
-
 Panel labels_panel(const FrameView& f, const ViewMap& view, std::pair<double, double> range) {
   Canvas c(view.width, view.height, draw::colours::kBlack);
   draw_depth(c, view, *f.depth, range, 0.35);
@@ -299,6 +243,15 @@ std::optional<double> fingertip_error_mm(const TrackerOutput& output, const Fing
   return sum / n;
 }
 
+std::optional<double> nearest_fingertip_error_mm(const TrackerOutput& output, const std::vector<Fingertips>& truth) {
+  std::optional<double> best;
+  for (const Fingertips& hand : truth) {
+    const auto err = fingertip_error_mm(output, hand);
+    if (err && (!best || *err < *best)) best = err;
+  }
+  return best;
+}
+
 DepthInput unmirrored(const DepthInput& input) {
   DepthInput out = input;
   const int w = input.camera.width;
@@ -318,10 +271,13 @@ DepthInput unmirrored(const DepthInput& input) {
 }
 
 RgbImage render_frame(const FrameView& f, const RenderOptions& options) {
-  if (f.depth == nullptr || f.input == nullptr || f.output == nullptr || f.model == nullptr) {
-    throw std::invalid_argument("render_frame: depth, input, output and model are required");
+  if (f.depth == nullptr) throw std::invalid_argument("render_frame: the depth image is required");
+  for (const HandView& h : f.hands) {
+    if (h.input == nullptr || h.output == nullptr || h.model == nullptr) {
+      throw std::invalid_argument("render_frame: each hand needs its input, output and model");
+    }
   }
-  const ViewMap view = make_view(*f.input, options);
+  const ViewMap view = make_view(*f.depth, inputs_of(f), options);
   const auto range = depth_range(f.depth->depth_mm);
   std::vector<Panel> panels;
   panels.push_back(depth_panel(f, view, range));
