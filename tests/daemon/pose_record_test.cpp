@@ -1,6 +1,7 @@
 // The core -> ipc seam (daemon/pipeline/pose_record.cpp): every field of a TrackerOutput lands in
 // the hand record clients read, at the index clients expect; every tracking state and handedness
-// keeps its meaning across the seam; no hand seen is a frame with no hands.
+// keeps its meaning across the seam; no hand seen is a frame with no hands; two hands are two
+// records, each with its own optimize time.
 #include "pose_record.hpp"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,17 @@
 namespace handtrack::daemon {
 namespace {
 
+// A frame with the one hand `hand` whose optimisation took `optimize_ms` (none when its state is
+// no hand).
+HandsOutput one_hand(const TrackerOutput& hand, double optimize_ms = 1.0) {
+  HandsOutput out;
+  if (hand.state == TrackingState::kNoHand) return out;
+  out.count = 1;
+  out.hands[0] = hand;
+  out.optimize_ms[0] = optimize_ms;
+  return out;
+}
+
 TEST(PoseRecordSeam, EveryTrackingStateKeepsItsMeaning) {
   EXPECT_EQ(to_ipc(TrackingState::kNoHand), ipc::TrackingState::kNoHand);
   EXPECT_EQ(to_ipc(TrackingState::kTracking), ipc::TrackingState::kTracking);
@@ -18,7 +30,7 @@ TEST(PoseRecordSeam, EveryTrackingStateKeepsItsMeaning) {
   TrackerOutput o;
   o.state = TrackingState::kRecovering;
   o.hand_id = 3;
-  fill_hands(o, HandScale{}, 1.0F, r);
+  fill_hands(one_hand(o), HandScale{}, r);
   ASSERT_EQ(r.hand_count, 1U);
   EXPECT_EQ(r.hands[0].state, HANDTRACK_STATE_RECOVERING);
 }
@@ -34,7 +46,7 @@ TEST(PoseRecordSeam, EveryHandednessKeepsItsMeaning) {
     o.hand_id = 1;
     o.handedness = hand;
     ipc::FrameRecord r{};
-    fill_hands(o, HandScale{}, 1.0F, r);
+    fill_hands(one_hand(o), HandScale{}, r);
     EXPECT_EQ(r.hands[0].handedness, code) << to_string(hand);
   }
 }
@@ -44,9 +56,9 @@ TEST(PoseRecordSeam, NoHandIsAFrameWithoutHands) {
   TrackerOutput tracked;
   tracked.state = TrackingState::kTracking;
   tracked.hand_id = 4;
-  fill_hands(tracked, HandScale{}, 1.0F, r);  // the record is reused frame after frame
+  fill_hands(one_hand(tracked), HandScale{}, r);  // the record is reused frame after frame
   ASSERT_EQ(r.hand_count, 1U);
-  fill_hands(TrackerOutput{}, HandScale{}, 1.0F, r);
+  fill_hands(HandsOutput{}, HandScale{}, r);
   EXPECT_EQ(r.hand_count, 0U);
   EXPECT_EQ(r.hands[0].hand_id, 0U) << "the lost hand's record is cleared";
   EXPECT_EQ(r.hands[0].state, HANDTRACK_STATE_NO_HAND);
@@ -70,7 +82,7 @@ TEST(PoseRecordSeam, EveryValueLandsInItsField) {
   const HandScale scale{.length = 1.1, .width = 0.9, .sigma = 1.05};
   ipc::FrameRecord r{};
   r.frame = 77;  // the publisher's fields are left alone
-  fill_hands(o, scale, 2.5F, r);
+  fill_hands(one_hand(o, 2.5), scale, r);
   EXPECT_EQ(r.frame, 77U);
   ASSERT_EQ(r.hand_count, 1U);
   const ipc::HandRecord& h = r.hands[0];
@@ -100,6 +112,32 @@ TEST(PoseRecordSeam, EveryValueLandsInItsField) {
   EXPECT_FLOAT_EQ(h.hand_scale[2], 1.05F);
   EXPECT_EQ(h.flags, 0U);
   EXPECT_EQ(r.hands[1].hand_id, 0U) << "one hand tracked: the second record stays empty";
+}
+
+TEST(PoseRecordSeam, TwoHandsAreTwoRecordsEachWithItsOwnTimes) {
+  HandsOutput out;
+  out.count = 2;
+  out.hands[0].state = TrackingState::kRecovering;
+  out.hands[0].hand_id = 5;
+  out.hands[0].handedness = Handedness::kRight;
+  out.hands[1].state = TrackingState::kTracking;
+  out.hands[1].hand_id = 6;
+  out.hands[1].handedness = Handedness::kLeft;
+  out.optimize_ms = {1.5, 2.25};
+  ipc::FrameRecord r{};
+  fill_hands(out, HandScale{}, r);
+  ASSERT_EQ(r.hand_count, 2U);
+  EXPECT_EQ(r.hands[0].hand_id, 5U);
+  EXPECT_EQ(r.hands[0].handedness, HANDTRACK_HANDEDNESS_RIGHT);
+  EXPECT_FLOAT_EQ(r.hands[0].optimize_ms, 1.5F);
+  EXPECT_EQ(r.hands[1].hand_id, 6U);
+  EXPECT_EQ(r.hands[1].handedness, HANDTRACK_HANDEDNESS_LEFT);
+  EXPECT_FLOAT_EQ(r.hands[1].optimize_ms, 2.25F);
+  // The frame's state: tracking when any hand tracks, else recovering, else no hand.
+  EXPECT_EQ(frame_state(out), TrackingState::kTracking);
+  out.hands[1].state = TrackingState::kRecovering;
+  EXPECT_EQ(frame_state(out), TrackingState::kRecovering);
+  EXPECT_EQ(frame_state(HandsOutput{}), TrackingState::kNoHand);
 }
 
 }  // namespace

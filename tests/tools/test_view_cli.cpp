@@ -38,21 +38,6 @@ struct PngSize {
   int height = 0;
 };
 
-// Reads `file` completely as RGB; nullopt unless it is a valid PNG.
-std::optional<PngSize> read_png_size(const fs::path& file) {
-  png_image png;
-  std::memset(&png, 0, sizeof png);
-  png.version = PNG_IMAGE_VERSION;
-  if (png_image_begin_read_from_file(&png, file.c_str()) == 0) return std::nullopt;
-  png.format = PNG_FORMAT_RGB;
-  std::vector<uint8_t> pixels(PNG_IMAGE_SIZE(png));
-  const bool ok = png_image_finish_read(&png, nullptr, pixels.data(), 0, nullptr) != 0;
-  const PngSize size{static_cast<int>(png.width), static_cast<int>(png.height)};
-  png_image_free(&png);
-  if (!ok) return std::nullopt;
-  return size;
-}
-
 struct RgbPng {
   int width = 0;
   int height = 0;
@@ -63,6 +48,7 @@ struct RgbPng {
   }
 };
 
+// Reads `file` completely as RGB; nullopt unless it is a valid PNG.
 std::optional<RgbPng> read_png_rgb(const fs::path& file) {
   png_image png;
   std::memset(&png, 0, sizeof png);
@@ -74,6 +60,13 @@ std::optional<RgbPng> read_png_rgb(const fs::path& file) {
   png_image_free(&png);
   if (!ok) return std::nullopt;
   return out;
+}
+
+// The size of `file`, read completely; nullopt unless it is a valid PNG.
+std::optional<PngSize> read_png_size(const fs::path& file) {
+  const auto png = read_png_rgb(file);
+  if (!png) return std::nullopt;
+  return PngSize{png->width, png->height};
 }
 
 // Whether `pixel` is `colour` as handtrack-view draws a hand in it: the colour itself, blended over

@@ -130,25 +130,6 @@ void BM_SimilarityReference(benchmark::State& state) {
 }
 BENCHMARK(BM_SimilarityReference)->ArgName("label")->Arg(0)->Arg(1);
 
-// The whole energy of eq. 2 with its gradient, as the optimizer calls it (E_smo on).
-void BM_PoseEnergy(benchmark::State& state) {
-  const PoseEnergy energy(factor_of(state), EnergyWeights{});
-  PosedHand hand;
-  size_t i = 0;
-  size_t k = 0;
-  for (auto _ : state) {
-    const auto& c = cases()[i];
-    const EnergyFrame frame{&model(), &c.input, &c.truth, &c.truth};
-    PoseGradient g;
-    benchmark::DoNotOptimize(energy.evaluate(frame, c.poses[k], hand, &g));
-    benchmark::DoNotOptimize(g.data());
-    if (++k == c.poses.size()) {
-      k = 0;
-      i = (i + 1) % cases().size();
-    }
-  }
-}
-BENCHMARK(BM_PoseEnergy)->ArgName("label")->Arg(0)->Arg(1);
 
 // The other hand for E_hand (issue 14): the frame's true pose mirrored (a left hand), its wrist
 // `gap_mm` to this hand's thumb side; 50 mm: the hands interpenetrate by about a finger, 600 mm:
@@ -188,10 +169,11 @@ void BM_InterHand(benchmark::State& state) {
 }
 BENCHMARK(BM_InterHand)->ArgNames({"gap_mm", "reference"})->Args({50, 0})->Args({600, 0})->Args({50, 1});
 
-// PoseEnergy (depth factor) as BM_PoseEnergy, with another hand range(0) mm away (0: none).
-void BM_PoseEnergyTwoHands(benchmark::State& state) {
-  const PoseEnergy energy(SimilarityFactor::kDepth, EnergyWeights{});
-  const auto gap_mm = static_cast<int>(state.range(0));
+// The whole energy of eq. 2 with its gradient, as the optimizer calls it (E_smo on), with the label
+// factor or not (range(0)), and another hand range(1) mm away (0: none; E_hand).
+void BM_PoseEnergy(benchmark::State& state) {
+  const PoseEnergy energy(factor_of(state), EnergyWeights{});
+  const auto gap_mm = static_cast<int>(state.range(1));
   PosedHand hand;
   size_t i = 0;
   size_t k = 0;
@@ -208,7 +190,7 @@ void BM_PoseEnergyTwoHands(benchmark::State& state) {
     }
   }
 }
-BENCHMARK(BM_PoseEnergyTwoHands)->ArgName("gap_mm")->Arg(0)->Arg(50)->Arg(600);
+BENCHMARK(BM_PoseEnergy)->ArgNames({"label", "gap_mm"})->Args({0, 0})->Args({1, 0})->Args({0, 50})->Args({0, 600});
 
 // AdaptiveGradientAscent::maximise from a pose off the truth: range(1) iterations (each one
 // evaluation, plus one at the start).
