@@ -69,6 +69,13 @@ bool Skeleton::within(const Vector3d& p, double r2) const {
   return false;
 }
 
+HandSplitter::HandSplitter() {
+  surfaces_.reserve(kReservedSurfaces);
+  claims_.reserve(kReservedSurfaces);
+  owner_.reserve(kReservedSurfaces);
+  skeletons_.reserve(kMaxHands);
+}
+
 void HandSplitter::claim(const DepthInputConfig& config, const CameraIntrinsics& cam, const HandsRequest& request) {
   const int w = cam.width;
   const int h = cam.height;
@@ -142,6 +149,7 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
   const int w = cam.width;
   const int h = cam.height;
   const auto n = static_cast<size_t>(w) * h;
+  stack_.reserve(n);  // label_surfaces' flood fill holds at most every pixel
   // The surfaces of the median-filtered working volume (as HandSegmenter sees them: flying pixels
   // between two hands would otherwise join them).
   const std::vector<float>& median = median_.apply(depth, config.median_radius_px);

@@ -42,6 +42,7 @@ class Skeleton {
 
 class HandSplitter {
  public:
+  HandSplitter();
   // Writes share[i], out[i] for kOwn and, for a free slot taking a new surface, that surface's
   // centroid into candidate[i].
   void split(const DepthInputConfig& config, const DepthImage& depth, const HandsRequest& request,
@@ -63,6 +64,11 @@ class HandSplitter {
   // The free slots' surfaces: nearest first, big enough, not a body reaching through the far plane,
   // not where a surface was recently found to be no hand.
   void choose_new(const DepthInputConfig& config, const CameraIntrinsics& camera, const HandsRequest& request);
+
+  // Room for this many surfaces from the start (noise makes dozens of one-pixel surfaces, a hand
+  // and its forearm one or a few): a pipeline's frames each have a splitter, and each would
+  // otherwise grow its storage frame by frame as it meets more surfaces.
+  static constexpr size_t kReservedSurfaces = 1024;
 
   MedianFilter median_;
   std::vector<float> volume_;  // median depth in the working volume, 0 outside

@@ -21,21 +21,33 @@ HandsInputs::HandsInputs(HandsInputs&&) noexcept = default;
 HandsInputs& HandsInputs::operator=(HandsInputs&&) noexcept = default;
 
 void HandsInputs::build(const DepthImage& depth, const HandsRequest& request, const PixelLabeller* labeller) {
+  const uint32_t slots = share(depth, request);
+  for (int s = 0; s < kMaxHands; ++s) {
+    if ((slots & (1U << static_cast<unsigned>(s))) != 0) build_slot(s, depth, request, labeller);
+  }
+}
+
+uint32_t HandsInputs::share(const DepthImage& depth, const HandsRequest& request) {
   if (request.max_hands <= 1) {
     // One hand: the whole frame, exactly as a Tracker alone sees it.
-    inputs_[0].build(depth, request.slots[0].request, labeller);
-    has_.fill(false);
-    has_[0] = true;
+    share_.fill(FrameShare::kNothing);
+    share_[0] = FrameShare::kWhole;
     candidate_.fill(std::nullopt);
-    return;
+  } else {
+    splitter_->split(config_, depth, request, depth_, share_, candidate_);
   }
-  splitter_->split(config_, depth, request, depth_, share_, candidate_);
+  uint32_t slots = 0;
   for (size_t s = 0; s < kMaxHands; ++s) {
     has_[s] = share_[s] != FrameShare::kNothing;
-    if (has_[s]) {
-      inputs_[s].build(share_[s] == FrameShare::kWhole ? depth : depth_[s], request.slots[s].request, labeller);
-    }
+    if (has_[s]) slots |= 1U << s;
   }
+  return slots;
+}
+
+void HandsInputs::build_slot(int slot, const DepthImage& depth, const HandsRequest& request,
+                             const PixelLabeller* labeller) {
+  const auto s = static_cast<size_t>(slot);
+  inputs_[s].build(share_[s] == FrameShare::kWhole ? depth : depth_[s], request.slots[s].request, labeller);
 }
 
 HandsTracker::HandsTracker(const TrackerConfig& config)

@@ -295,8 +295,9 @@ bool Pipeline::start(std::string* why) {
   if (m.forest) log().info("part forest {}: late fusion", forest_path->string());
   m.reload.emplace(m.config.tracker);
   const PartForest* forest = m.forest ? &*m.forest : nullptr;
-  m.preprocess.emplace(m.config.tracker, *m.reload, m.request, forest, m.tally, m.watch);
-  // The second hand's side thread shares the preprocess stage's CPU: the optimize thread keeps its own.
+  // Each stage's side thread (the second hand) shares the other stage's CPU.
+  m.preprocess.emplace(m.config.tracker, *m.reload, m.request, forest, m.tally, m.watch, !m.config.single_thread,
+                       [&m] { setup_pipeline_thread("ht-preprocess-2", m.config.pipeline.cpu[2], m.config.pipeline); });
   m.optimize.emplace(m.config.tracker, *m.reload, m.request, m.watch, !m.config.single_thread,
                      [&m] { setup_pipeline_thread("ht-optimize-2", m.config.pipeline.cpu[1], m.config.pipeline); });
   m.publish.emplace(m.ring, m.tally, m.watch, m.stats);

@@ -8,8 +8,12 @@
 namespace handtrack::daemon {
 
 PreprocessStage::PreprocessStage(const TrackerConfig& config, TrackerReload& reload, const RequestMailbox& request,
-                                 const PartForest* forest, PipelineTally& tally, StageWatch& watch)
-    : reload_(reload), request_(request), forest_(forest), tally_(tally), watch_(watch), input_config_(config.input) {}
+                                 const PartForest* forest, PipelineTally& tally, StageWatch& watch, bool side,
+                                 std::function<void()> side_setup)
+    : reload_(reload), request_(request), forest_(forest), tally_(tally), watch_(watch), input_config_(config.input) {
+  build_side_ = [this] { side_frame_->inputs.build_slot(1, side_frame_->depth, side_request_, forest_); };
+  if (side) side_ = std::make_unique<SideThread>(std::move(side_setup));
+}
 
 void PreprocessStage::apply_reload() {
   if (const auto g = reload_.generation(); g != input_generation_) {
@@ -51,7 +55,19 @@ void PreprocessStage::step(Frame& f) {
     if (in_volume == 0) {
       f.empty = true;
     } else {
-      f.inputs.build(f.depth, request_.get(), forest_);
+      side_request_ = request_.get();
+      const uint32_t slots = f.inputs.share(f.depth, side_request_);
+      const bool parallel = side_ != nullptr && slots == 3U;
+      if (parallel) {
+        side_frame_ = &f;
+        side_->post(build_side_);
+      }
+      for (int s = 0; s < kMaxHands; ++s) {
+        if ((slots & (1U << static_cast<unsigned>(s))) != 0 && !(parallel && s == 1)) {
+          f.inputs.build_slot(s, f.depth, side_request_, forest_);
+        }
+      }
+      if (parallel) side_->wait();
       f.has_input = true;
     }
   }

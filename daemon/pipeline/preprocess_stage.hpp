@@ -6,21 +6,32 @@
 // the working volume are marked empty (published as no_hand). The first frame of a new resolution
 // is marked so that the optimizer restarts.
 //
-// Thread roles: thread-bound: step() from the preprocess thread (or the single thread).
+// With two hands in a frame the second hand's input is built on a side thread while the preprocess
+// thread builds the first's (the forest's labels are most of the work; PartForest is thread-safe).
+//
+// Thread roles: thread-bound: step() from the preprocess thread (or the single thread); the side
+// thread runs only HandsInputs::build_slot() of the second hand, between post() and wait() in step().
 #include "frame.hpp"
 #include "pipeline_tally.hpp"
 #include "stage_links.hpp"
 #include "stage_watch.hpp"
 
+#include "handtrack/common/side_thread.hpp"
 #include "handtrack/core/part_forest.hpp"
+
+#include <functional>
+#include <memory>
 
 namespace handtrack::daemon {
 
 class PreprocessStage {
  public:
   // `forest` may be null (depth-only); it outlives the stage.
+  // `side`: build a frame's second hand on a side thread (not in --single-thread mode);
+  // `side_setup` runs first on that thread (name, CPU).
   PreprocessStage(const TrackerConfig& config, TrackerReload& reload, const RequestMailbox& request,
-                  const PartForest* forest, PipelineTally& tally, StageWatch& watch);
+                  const PartForest* forest, PipelineTally& tally, StageWatch& watch, bool side = false,
+                  std::function<void()> side_setup = {});
 
   // Inputs for a new pool frame, for the configuration in force.
   [[nodiscard]] HandsInputs make_inputs() const { return HandsInputs(input_config_); }
@@ -38,6 +49,11 @@ class PreprocessStage {
   uint64_t input_generation_ = 0;
   int stream_width_ = 0;
   int stream_height_ = 0;
+  // The side thread's job: slot 1 of the frame being preprocessed (set before post()).
+  Frame* side_frame_ = nullptr;
+  HandsRequest side_request_;
+  std::function<void()> build_side_;
+  std::unique_ptr<SideThread> side_;
 };
 
 }  // namespace handtrack::daemon

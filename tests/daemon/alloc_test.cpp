@@ -59,8 +59,8 @@ using namespace std::chrono_literals;
 // Replays pre-rendered raw frames: a source that itself never allocates.
 class ReplaySource final : public DepthSource {
  public:
-  explicit ReplaySource(int frames) {
-    synth::SyntheticCamera camera(synthetic_source_options("pinch"));
+  ReplaySource(const std::string& motion, int frames) {
+    synth::SyntheticCamera camera(synthetic_source_options(motion));
     for (int i = 0; i < frames; ++i) {
       const auto depth = camera.render(i).depth;
       RawFrame raw;
@@ -101,7 +101,9 @@ uint64_t wait_for_published(const Pipeline& pipeline, uint64_t n) {
   return pipeline.counters().frames_published;
 }
 
-void expect_no_steady_state_allocation(bool single_thread) {
+// `motion`: one of the synthetic camera's, one hand or two (both hands preprocessed and optimized
+// on two threads).
+void expect_no_steady_state_allocation(bool single_thread, const std::string& motion = "pinch") {
   DaemonConfig config;
   config.fast = true;
   config.single_thread = single_thread;
@@ -109,7 +111,7 @@ void expect_no_steady_state_allocation(bool single_thread) {
   const std::string name = "htd-alloc-test-" + std::to_string(getpid());
   ipc::PoseRingWriter ring(ipc::PoseRingWriter::Options{.name = name, .capacity = 64});
   {
-    Pipeline pipeline(config, std::make_unique<ReplaySource>(60), ring);
+    Pipeline pipeline(config, std::make_unique<ReplaySource>(motion, 60), ring);
     std::string why;
     ASSERT_TRUE(pipeline.start(&why)) << why;
     ASSERT_GE(wait_for_published(pipeline, 40), 40U);  // warm-up: every pool frame has been used
@@ -129,6 +131,7 @@ void expect_no_steady_state_allocation(bool single_thread) {
 
 TEST(SteadyState, PipelinedDaemonDoesNotAllocate) { expect_no_steady_state_allocation(false); }
 TEST(SteadyState, SingleThreadedDaemonDoesNotAllocate) { expect_no_steady_state_allocation(true); }
+TEST(SteadyState, PipelinedDaemonWithTwoHandsDoesNotAllocate) { expect_no_steady_state_allocation(false, "two_apart"); }
 
 }  // namespace
 }  // namespace handtrack::daemon

@@ -78,6 +78,11 @@ class HandsInputs {
   HandsInputs& operator=(HandsInputs&&) noexcept;
 
   void build(const DepthImage& depth, const HandsRequest& request, const PixelLabeller* labeller = nullptr);
+  // build() in two steps, for a caller that builds the slots on several threads: share() shares the
+  // frame out and says which slots to build (a bit per slot); build_slot(i) of different slots may
+  // then run at once (`depth` and `request` as given to share(), unchanged until they return).
+  uint32_t share(const DepthImage& depth, const HandsRequest& request);
+  void build_slot(int slot, const DepthImage& depth, const HandsRequest& request, const PixelLabeller* labeller);
   // Whether slot `i` has an input this frame: the pixels of the hand it tracks, or a surface that
   // may be a new hand (a free slot).
   [[nodiscard]] bool has(int slot) const { return has_[static_cast<size_t>(slot)]; }
