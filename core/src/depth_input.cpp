@@ -34,7 +34,7 @@ DepthInputBuilder::DepthInputBuilder(DepthInputBuilder&&) noexcept = default;
 DepthInputBuilder& DepthInputBuilder::operator=(DepthInputBuilder&&) noexcept = default;
 
 const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::optional<HandHint>& hint,
-                                           const PixelLabeller* labeller) {
+                                           const PixelLabeller* labeller, const std::vector<uint8_t>* foreign) {
   out_.camera = depth.camera;
   // Median, then the working volume (Sec. 4): 0 outside [near, far].
   const std::vector<float>& median = steps_->median.apply(depth, config_.median_radius_px);
@@ -45,7 +45,7 @@ const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::o
     const float m = median[i];
     out_.filtered_mm[i] = (m >= near && m <= far) ? m : 0.0F;
   }
-  steps_->segmenter.segment(config_, median, hint, out_);
+  steps_->segmenter.segment(config_, median, hint, out_, foreign);
   out_.pixel_labels.clear();
   if (labeller != nullptr && out_.hand_pixels > 0) labeller->label(out_, out_.pixel_labels);
   steps_->quadtree.build(config_, steps_->segmenter.hand_box(), out_);

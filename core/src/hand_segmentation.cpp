@@ -84,12 +84,18 @@ bool nothing_in(const float* d) {
 }  // namespace
 
 void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
-                            const std::optional<HandHint>& hint, DepthInput& out) {
+                            const std::optional<HandHint>& hint, DepthInput& out, const std::vector<uint8_t>* foreign) {
   const auto& cam = out.camera;
   const int w = cam.width;
   const int h = cam.height;
   const auto n = static_cast<size_t>(w) * h;
-  const auto& d = out.filtered_mm;
+  // The surfaces this hand may be segmented from: the filtered depth, without the foreign pixels
+  // (out.filtered_mm keeps them: they still hide what is behind them).
+  if (foreign != nullptr && foreign->size() == n) {
+    own_mm_.resize(n);
+    for (size_t i = 0; i < n; ++i) own_mm_[i] = (*foreign)[i] != 0 ? 0.0F : out.filtered_mm[i];
+  }
+  const auto& d = foreign != nullptr && foreign->size() == n ? own_mm_ : out.filtered_mm;
   out.hand_mask.assign(n, 0);
   out.hand_pixels = 0;
   const auto point = [&](size_t i) {

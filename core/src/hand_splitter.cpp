@@ -143,7 +143,7 @@ void HandSplitter::claim(const DepthInputConfig& config, const CameraIntrinsics&
 }
 
 void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth, const HandsRequest& request,
-                         std::array<DepthImage, kMaxHands>& out, std::array<FrameShare, kMaxHands>& share,
+                         std::array<std::vector<uint8_t>, kMaxHands>& foreign, std::array<FrameShare, kMaxHands>& share,
                          std::array<std::optional<Vector3d>, kMaxHands>& candidate) {
   const CameraIntrinsics& cam = depth.camera;
   const int w = cam.width;
@@ -213,15 +213,14 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
 
   for (int s = 0; s < kMaxHands; ++s) {
     if (share[static_cast<size_t>(s)] != FrameShare::kOwn) continue;
-    DepthImage& mine = out[static_cast<size_t>(s)];
-    mine.camera = cam;
-    mine.depth_mm.resize(n);
+    std::vector<uint8_t>& not_mine = foreign[static_cast<size_t>(s)];
+    not_mine.resize(n);
     const int fresh = new_surface[static_cast<size_t>(s)];
     for (int v = 0; v < h; ++v) {
       for (int u = 0; u < w; ++u) {
         const auto i = static_cast<size_t>(v) * w + u;
         const int c = component_[i];
-        mine.depth_mm[i] = 0.0F;
+        not_mine[i] = 1;
         if (c < 0) continue;
         const int owner = owner_[static_cast<size_t>(c)];
         bool keep = fresh >= 0 ? c == fresh : owner == s;
@@ -236,7 +235,7 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
             keep = keep && mine2 <= skeletons_[static_cast<size_t>(k)].distance2(p);
           }
         }
-        if (keep) mine.depth_mm[i] = depth.depth_mm[i];
+        if (keep) not_mine[i] = 0;
       }
     }
   }

@@ -43,10 +43,10 @@ class Skeleton {
 class HandSplitter {
  public:
   HandSplitter();
-  // Writes share[i], out[i] for kOwn and, for a free slot taking a new surface, that surface's
-  // centroid into candidate[i].
+  // Writes share[i], foreign[i] for kOwn (1 for every pixel that is not slot i's) and, for a free
+  // slot taking a new surface, that surface's centroid into candidate[i].
   void split(const DepthInputConfig& config, const DepthImage& depth, const HandsRequest& request,
-             std::array<DepthImage, kMaxHands>& out, std::array<FrameShare, kMaxHands>& share,
+             std::array<std::vector<uint8_t>, kMaxHands>& foreign, std::array<FrameShare, kMaxHands>& share,
              std::array<std::optional<Eigen::Vector3d>, kMaxHands>& candidate);
 
  private:

@@ -34,7 +34,7 @@ uint32_t HandsInputs::share(const DepthImage& depth, const HandsRequest& request
     share_[0] = FrameShare::kWhole;
     candidate_.fill(std::nullopt);
   } else {
-    splitter_->split(config_, depth, request, depth_, share_, candidate_);
+    splitter_->split(config_, depth, request, foreign_, share_, candidate_);
   }
   uint32_t slots = 0;
   for (size_t s = 0; s < kMaxHands; ++s) {
@@ -47,7 +47,7 @@ uint32_t HandsInputs::share(const DepthImage& depth, const HandsRequest& request
 void HandsInputs::build_slot(int slot, const DepthImage& depth, const HandsRequest& request,
                              const PixelLabeller* labeller) {
   const auto s = static_cast<size_t>(slot);
-  inputs_[s].build(share_[s] == FrameShare::kWhole ? depth : depth_[s], request.slots[s].request, labeller);
+  inputs_[s].build(depth, request.slots[s].request, labeller, share_[s] == FrameShare::kWhole ? nullptr : &foreign_[s]);
 }
 
 HandsTracker::HandsTracker(const TrackerConfig& config)

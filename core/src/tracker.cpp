@@ -106,14 +106,20 @@ namespace {
 
 // The frame a camera takes of the scene's mirror image about x = 0 (Tracker): the rows reversed,
 // the principal point mirrored.
+// An image of `width` columns flipped left to right, row by row.
+template <typename T>
+void mirror_rows(const std::vector<T>& in, int width, std::vector<T>& out) {
+  out.resize(in.size());
+  const auto w = static_cast<std::ptrdiff_t>(width);
+  for (std::ptrdiff_t row = 0; row + w <= static_cast<std::ptrdiff_t>(in.size()); row += w) {
+    std::reverse_copy(in.begin() + row, in.begin() + row + w, out.begin() + row);
+  }
+}
+
 void mirror_depth(const DepthImage& in, DepthImage& out) {
   out.camera = in.camera;
   out.camera.cx = static_cast<double>(in.camera.width - 1) - in.camera.cx;
-  out.depth_mm.resize(in.depth_mm.size());
-  const auto w = static_cast<std::ptrdiff_t>(in.camera.width);
-  for (std::ptrdiff_t row = 0; row + w <= static_cast<std::ptrdiff_t>(in.depth_mm.size()); row += w) {
-    std::reverse_copy(in.depth_mm.begin() + row, in.depth_mm.begin() + row + w, out.depth_mm.begin() + row);
-  }
+  mirror_rows(in.depth_mm, in.camera.width, out.depth_mm);
 }
 
 // A pose found in the mirrored frame, back in the camera's: every point and direction reflected.
@@ -128,13 +134,15 @@ void mirror_output(TrackerOutput& out) {
 
 TrackerInputs::TrackerInputs(const DepthInputConfig& config) : right_(config), left_(config) {}
 
-void TrackerInputs::build(const DepthImage& depth, const InputRequest& request, const PixelLabeller* labeller) {
+void TrackerInputs::build(const DepthImage& depth, const InputRequest& request, const PixelLabeller* labeller,
+                          const std::vector<uint8_t>* foreign) {
   has_right_ = request.right;
   has_left_ = request.left;
-  if (has_right_) right_.build(depth, request.right_hint, labeller);
+  if (has_right_) right_.build(depth, request.right_hint, labeller, foreign);
   if (has_left_) {
     mirror_depth(depth, mirrored_);
-    left_.build(mirrored_, request.left_hint, labeller);
+    if (foreign != nullptr) mirror_rows(*foreign, depth.camera.width, mirrored_foreign_);
+    left_.build(mirrored_, request.left_hint, labeller, foreign != nullptr ? &mirrored_foreign_ : nullptr);
   }
 }
 

@@ -94,9 +94,12 @@ class DepthInputBuilder {
   DepthInputBuilder& operator=(DepthInputBuilder&&) noexcept;
 
   // Builds C_I for one frame. With a `labeller`, the hand's pixels get part labels and each
-  // quadtree leaf the majority label of its pixels (Sec. 4.3). Storage is reused between calls.
+  // quadtree leaf the majority label of its pixels (Sec. 4.3). `foreign` (one byte per pixel, may be
+  // null): pixels that are not this hand's (another hand's: HandsTracker); they stay depth, so that
+  // a model part behind another hand counts as hidden, not as floating over nothing, but are never
+  // segmented as the hand. Storage is reused between calls.
   const DepthInput& build(const DepthImage& depth, const std::optional<HandHint>& hint,
-                          const PixelLabeller* labeller = nullptr);
+                          const PixelLabeller* labeller = nullptr, const std::vector<uint8_t>* foreign = nullptr);
   [[nodiscard]] const DepthInput& last() const { return out_; }
   [[nodiscard]] const DepthInputConfig& config() const { return config_; }
 

@@ -12,8 +12,9 @@
 //   3. A free slot takes the nearest unclaimed surface that could be a hand (big enough, not a
 //      body reaching in through the far plane); a new hand therefore appears only apart from the
 //      hands already tracked, and one that touches a tracked hand waits until they part.
-//   4. Each slot's Tracker sees a depth image with every pixel but its own removed (0, no
-//      measurement), and fits it exactly as it fits a single hand.
+//   4. Each slot's Tracker sees the frame with every pixel but its own marked foreign: never its
+//      hand, but still depth (a hand behind the other is hidden there, not floating over nothing),
+//      and fits it exactly as it fits a single hand.
 //
 // A slot whose Tracker finds no hand keeps its id and last pose, unreported, for
 // TrackerConfig::hidden_hand_frames frames (a hand hidden behind the other one keeps its id when it
@@ -87,9 +88,6 @@ class HandsInputs {
   // may be a new hand (a free slot).
   [[nodiscard]] bool has(int slot) const { return has_[static_cast<size_t>(slot)]; }
   [[nodiscard]] const TrackerInputs& slot(int i) const { return inputs_[static_cast<size_t>(i)]; }
-  // The depth slot `i` was fitted on (its own pixels only), for viewers and tests.
-  // With one hand at most (max_hands 1) the whole frame, as Tracker sees it.
-  [[nodiscard]] const DepthImage& depth(int i) const { return depth_[static_cast<size_t>(i)]; }
   // A free slot's new surface: its centroid (camera frame, mm).
   [[nodiscard]] const std::optional<Eigen::Vector3d>& candidate(int i) const {
     return candidate_[static_cast<size_t>(i)];
@@ -98,7 +96,7 @@ class HandsInputs {
  private:
   DepthInputConfig config_;
   std::unique_ptr<HandSplitter> splitter_;
-  std::array<DepthImage, kMaxHands> depth_{};
+  std::array<std::vector<uint8_t>, kMaxHands> foreign_{};  // kOwn slots: 1 = not the slot's pixel
   std::array<TrackerInputs, kMaxHands> inputs_;
   std::array<bool, kMaxHands> has_{};
   std::array<FrameShare, kMaxHands> share_{};

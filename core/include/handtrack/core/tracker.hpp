@@ -236,7 +236,9 @@ struct InputRequest {
 class TrackerInputs {
  public:
   explicit TrackerInputs(const DepthInputConfig& config = {});
-  void build(const DepthImage& depth, const InputRequest& request, const PixelLabeller* labeller = nullptr);
+  // `foreign`: pixels that are not this hand's (DepthInputBuilder::build), or null.
+  void build(const DepthImage& depth, const InputRequest& request, const PixelLabeller* labeller = nullptr,
+             const std::vector<uint8_t>* foreign = nullptr);
   // Null when not built for this frame.
   [[nodiscard]] const DepthInput* get(Handedness hand) const {
     if (hand == Handedness::kLeft) return has_left_ ? &left_.last() : nullptr;
@@ -247,6 +249,7 @@ class TrackerInputs {
   DepthInputBuilder right_;
   DepthInputBuilder left_;
   DepthImage mirrored_;
+  std::vector<uint8_t> mirrored_foreign_;
   bool has_right_ = false;
   bool has_left_ = false;
 };
