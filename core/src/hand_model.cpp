@@ -137,6 +137,16 @@ Eigen::Vector3d HandModel::palm_centre() const {
   return {0.0, 0.5 * (fingers_[kMiddle].base.y()), 0.0};
 }
 
+double HandModel::palm_half_thickness_mm() const { return gaussians_.back().sigma_mm; }
+
+double HandModel::palm_half_width_mm() const {
+  double half_width = 0.0;
+  for (const auto& g : gaussians_) {
+    if (g.bone == kPalmBone) half_width = std::max(half_width, std::abs(g.palm_position.x()) + g.sigma_mm);
+  }
+  return half_width;
+}
+
 double HandModel::hand_length_mm() const {
   const auto& f = fingers_[kMiddle];
   return f.base.y() + f.length_mm[0] + f.length_mm[1] + f.length_mm[2];

@@ -70,6 +70,8 @@ double fit_score(double confidence, double label_agreement) {
   return label_agreement < 0.0 ? confidence : confidence * label_agreement;
 }
 
+double TrackerOutput::score() const { return fit_score(confidence, label_agreement); }
+
 const char* to_string(EnergyMode mode) {
   return mode == EnergyMode::kLateFusion ? "late-fusion" : "depth-only";
 }
@@ -195,8 +197,8 @@ bool Tracker::prefer(const TrackerOutput& a, const TrackerOutput& b) const {
   // in one frame are usually a left and a right one.
   const bool a_palm = a.palm_normal.z() < 0.0;
   const bool b_palm = b.palm_normal.z() < 0.0;
-  const double a_score = fit_score(a.confidence, a.label_agreement);
-  const double b_score = fit_score(b.confidence, b.label_agreement);
+  const double a_score = a.score();
+  const double b_score = b.score();
   const bool tie = std::abs(a_score - b_score) < config().handedness_margin;
   if (tie && expected_ && a.handedness != b.handedness) return a.handedness == *expected_;
   if (tie && a_palm != b_palm) return a_palm;
@@ -226,9 +228,7 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
     const bool left_wins = prefer(as_left, as_right);
     current_ = left_wins ? Handedness::kLeft : Handedness::kRight;
     side(left_wins ? Handedness::kRight : Handedness::kLeft).reset();
-    handedness_confidence_ = std::clamp(std::abs(fit_score(as_left.confidence, as_left.label_agreement) -
-                                                 fit_score(as_right.confidence, as_right.label_agreement)),
-                                        0.0, 1.0);
+    handedness_confidence_ = std::clamp(std::abs(as_left.score() - as_right.score()), 0.0, 1.0);
     settled_ = handedness_confidence_ >= config().handedness_margin;
     frames_since_hand_check_ = 0;
     out = left_wins ? as_left : as_right;
@@ -326,12 +326,8 @@ PoseParams PoseTracker::initial_pose(const DepthInput& input, const Start& start
   // about two finger thicknesses.
   // (Measured the other way, as the depth of the posed model's nearest surface along the ray
   // through its palm centre, this put the fists of fingercount 75 mm off.)
-  const double palm_half_thickness = model_.gaussians().back().sigma_mm;  // the knuckle row's
-  double palm_half_width = 0.0;
-  for (const auto& g : model_.gaussians()) {
-    if (g.bone != kPalmBone) continue;
-    palm_half_width = std::max(palm_half_width, std::abs(g.palm_position.x()) + g.sigma_mm);
-  }
+  const double palm_half_thickness = model_.palm_half_thickness_mm();
+  const double palm_half_width = model_.palm_half_width_mm();
   // cos(turn): 1 with the palm toward the camera, -1 with the back (the curled fingers behind it).
   const double palm_toward = std::max(0.0, std::cos(start.turn_rad));
   const double facing = std::abs(std::cos(start.turn_rad));

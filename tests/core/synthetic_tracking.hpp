@@ -32,4 +32,34 @@ inline synth::SyntheticCamera motion_camera(std::string_view motion) {
   return synth::SyntheticCamera(options);
 }
 
+// One rendered hand tracked by a Tracker: the mean fingertip error over the frames with a pose, how
+// many had one, and how many of those were reported as the hand shown.
+struct OneHandRun {
+  double mean_error_mm = 0.0;
+  int posed = 0;
+  int reported_as_shown = 0;
+};
+
+inline OneHandRun track_one_hand(const synth::SynthOptions& options, const TrackerConfig& config,
+                                 const PixelLabeller* labeller = nullptr) {
+  synth::SyntheticCamera camera(options);
+  Tracker tracker(config);
+  const Handedness shown = options.hand == synth::Handedness::kLeft ? Handedness::kLeft : Handedness::kRight;
+  OneHandRun run;
+  double sum = 0.0;
+  synth::SynthFrame frame;
+  for (int i = 0; i < options.frames; ++i) {
+    camera.render(i, frame);
+    const TrackerOutput out = tracker.track(frame.depth, labeller);
+    if (out.state == TrackingState::kNoHand) continue;
+    ++run.posed;
+    run.reported_as_shown += out.handedness == shown ? 1 : 0;
+    double e = 0.0;
+    for (size_t t = 0; t < kNumFingers; ++t) e += (out.fingertips[t] - *frame.fingertips[t]).norm();
+    sum += e / kNumFingers;
+  }
+  run.mean_error_mm = run.posed > 0 ? sum / run.posed : 1e9;
+  return run;
+}
+
 }  // namespace handtrack::testing

@@ -12,6 +12,7 @@
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/tracker.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
+#include "synthetic_tracking.hpp"
 
 #include <gtest/gtest.h>
 
@@ -25,36 +26,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct HandRun {
-  double mean_error_mm = 0.0;
-  int posed = 0;
-  int reported_as_shown = 0;
-};
-
-HandRun track_synthetic(const std::string& motion, synth::Handedness hand, uint64_t seed) {
+testing::OneHandRun track_synthetic(const std::string& motion, synth::Handedness hand, uint64_t seed) {
   synth::SynthOptions options;
   options.motion = motion;
   options.frames = 120;
   options.seed = seed;
   options.hand = hand;
-  synth::SyntheticCamera camera(options);
-  Tracker tracker(TrackerConfig{});
-  const Handedness shown = hand == synth::Handedness::kLeft ? Handedness::kLeft : Handedness::kRight;
-  HandRun run;
-  double sum = 0.0;
-  synth::SynthFrame frame;
-  for (int i = 0; i < options.frames; ++i) {
-    camera.render(i, frame);
-    const TrackerOutput out = tracker.track(frame.depth);
-    if (out.state == TrackingState::kNoHand) continue;
-    ++run.posed;
-    run.reported_as_shown += out.handedness == shown ? 1 : 0;
-    double e = 0.0;
-    for (size_t t = 0; t < 5; ++t) e += (out.fingertips[t] - *frame.fingertips[t]).norm();
-    sum += e / 5.0;
-  }
-  run.mean_error_mm = run.posed > 0 ? sum / run.posed : 1e9;
-  return run;
+  return testing::track_one_hand(options, TrackerConfig{});
 }
 
 using HandCase = std::tuple<std::string, synth::Handedness, uint64_t>;
@@ -66,7 +44,7 @@ std::string case_name(const ::testing::TestParamInfo<HandCase>& c) {
 
 TEST_P(SyntheticHands, TrackedAndReportedAsTheHandTheyAre) {
   const auto& [motion, hand, seed] = GetParam();
-  const HandRun run = track_synthetic(motion, hand, seed);
+  const testing::OneHandRun run = track_synthetic(motion, hand, seed);
   EXPECT_GE(run.posed, 114) << "a pose in at least 95 % of the frames";
   EXPECT_LE(run.mean_error_mm, 12.0);
   EXPECT_GE(run.reported_as_shown, static_cast<int>(0.98 * run.posed))

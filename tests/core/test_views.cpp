@@ -9,6 +9,7 @@
 #include "handtrack/core/tracker.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
 #include "handtrack/synth/views.hpp"
+#include "synthetic_tracking.hpp"
 
 #include <gtest/gtest.h>
 
@@ -28,39 +29,16 @@ struct ViewCase {
   double min_handedness_share;  // of the frames with a pose, reported as the hand shown
 };
 
-struct ViewRun {
-  double mean_error_mm = 0.0;
-  int posed = 0;
-  int reported_as_shown = 0;
-};
-
-ViewRun track_view(const ViewCase& c, const PartForest& forest) {
+testing::OneHandRun track_view(const ViewCase& c, const PartForest& forest) {
   synth::SynthOptions options;
   options.motion = "pinch";
   options.frames = kFrames;
   options.seed = kSeed;
   options.hand = c.hand;
   options.view = c.view;
-  synth::SyntheticCamera camera(options);
   TrackerConfig config;
   config.mode = EnergyMode::kLateFusion;
-  Tracker tracker(config);
-  const Handedness shown = c.hand == synth::Handedness::kLeft ? Handedness::kLeft : Handedness::kRight;
-  ViewRun run;
-  double sum = 0.0;
-  synth::SynthFrame frame;
-  for (int i = 0; i < kFrames; ++i) {
-    camera.render(i, frame);
-    const TrackerOutput out = tracker.track(frame.depth, &forest);
-    if (out.state == TrackingState::kNoHand) continue;
-    ++run.posed;
-    run.reported_as_shown += out.handedness == shown ? 1 : 0;
-    double e = 0.0;
-    for (size_t t = 0; t < kNumFingers; ++t) e += (out.fingertips[t] - *frame.fingertips[t]).norm();
-    sum += e / kNumFingers;
-  }
-  run.mean_error_mm = run.posed > 0 ? sum / run.posed : 1e9;
-  return run;
+  return testing::track_one_hand(options, config, &forest);
 }
 
 class EveryView : public ::testing::TestWithParam<ViewCase> {};
@@ -68,7 +46,7 @@ class EveryView : public ::testing::TestWithParam<ViewCase> {};
 TEST_P(EveryView, PinchIsTrackedAsTheHandItIs) {
   const ViewCase& c = GetParam();
   const PartForest forest = PartForest::load(shipped_forest_path().value());
-  const ViewRun run = track_view(c, forest);
+  const testing::OneHandRun run = track_view(c, forest);
   const std::string name = std::string(synth::view_name(c.view)) + " " + std::string(synth::handedness_name(c.hand));
   std::printf("%s: %.1f mm, %d of %d frames posed, %d as the hand shown\n", name.c_str(), run.mean_error_mm, run.posed,
               kFrames, run.reported_as_shown);

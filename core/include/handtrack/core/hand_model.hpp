@@ -70,8 +70,13 @@ class HandModel {
   // E(C_h, C_h) of Sec. 4.1 at the rest pose: normalises E_col (a constant, so that the gradient
   // of E_col is that of its numerator).
   [[nodiscard]] double self_similarity() const { return self_similarity_; }
-  // Hand-frame point at the centre of the palm, and its half thickness (used for initialisation).
+  // Hand-frame point at the centre of the palm (used for initialisation).
   [[nodiscard]] Eigen::Vector3d palm_centre() const;
+  // Half the palm's thickness (the knuckle row's sigma) and half its width (from its centre line to
+  // the outer edge of its outermost Gaussian), mm: how far the palm centre lies behind the surface
+  // seen with the palm or the back, and with an edge, toward the camera.
+  [[nodiscard]] double palm_half_thickness_mm() const;
+  [[nodiscard]] double palm_half_width_mm() const;
   // Length from the wrist to the middle fingertip, mm.
   [[nodiscard]] double hand_length_mm() const;
 

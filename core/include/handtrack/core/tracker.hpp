@@ -131,6 +131,8 @@ struct TrackerOutput {
   // "recovering" frames and a change of the chosen hand) and is new each time a hand appears after
   // a frame without one; 0 when there is no hand. Counts from 1 within one Tracker.
   uint32_t hand_id = 0;
+  // fit_score() of this pose (below).
+  [[nodiscard]] double score() const;
 };
 
 // How well a fit explains the segmented hand, for choosing between fits (the (re)start hypotheses,
