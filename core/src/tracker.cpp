@@ -152,6 +152,12 @@ Tracker::Tracker(const TrackerConfig& config)
     : right_(config), left_(config), inputs_(config.input),
       current_(config.handedness == HandednessMode::kLeft ? Handedness::kLeft : Handedness::kRight) {}
 
+void Tracker::resume(const TrackerOutput& last) {
+  current_ = last.handedness;
+  side(current_).override_pose(last.params);
+  tracking_ = true;
+}
+
 void Tracker::reset() {
   right_.reset();
   left_.reset();

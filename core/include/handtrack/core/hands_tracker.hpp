@@ -16,10 +16,11 @@
 //      hand, but still depth (a hand behind the other is hidden there, not floating over nothing),
 //      and fits it exactly as it fits a single hand.
 //
-// A slot whose Tracker finds no hand keeps its id and last pose, unreported, for
-// TrackerConfig::hidden_hand_frames frames (a hand hidden behind the other one keeps its id when it
-// shows again near where it was); then it is freed and its id is never given out again, so a hand
-// that leaves and comes back has a fresh id and a fresh start. Where two hands are fitted the other
+// A slot whose Tracker finds no hand while another hand is seen (it may be hidden behind that one)
+// keeps its id and last pose, unreported, for TrackerConfig::hidden_hand_frames frames, and looks
+// for the hand where it was last seen: when it shows again near there it is the same hand. A hand
+// that finds no fit with no other hand in view, or stays away longer, has left: its slot is freed
+// and its id never given out again, so a hand that comes back has a fresh id and a fresh start. Where two hands are fitted the other
 // hand's last pose is an obstacle for each (EnergyFrame::other_hand, E_col between the hands).
 //
 // Threading: like Tracker, request() / begin() / finish() on one thread; fit(slot) of different

@@ -94,8 +94,9 @@ struct TrackerConfig {
   // A surface that a new hand's (re)start found to be no hand is not tried again for this many
   // frames (HandsTracker).
   int new_hand_retry_frames = 15;
-  // A hand that finds no fit (hidden behind the other hand, or gone) keeps its slot and id, unreported,
-  // for this many frames: where it shows again near its last pose it is the same hand (HandsTracker).
+  // A hand that finds no fit while another hand is seen (hidden behind it) keeps its slot and id,
+  // unreported, for this many frames: where it shows again near its last pose it is the same hand
+  // (HandsTracker).
   int hidden_hand_frames = 20;
   uint64_t seed = 1;
 };
@@ -309,6 +310,9 @@ class Tracker {
     frames_since_hand_check_ = config().handedness_check_frames;
   }
   [[nodiscard]] Handedness current_hand() const { return current_; }
+  // Carry on from `last` (a pose this tracker reported) at the next frame, as if it had just been
+  // tracked: HandsTracker's way back for a hand hidden behind the other, instead of a (re)start.
+  void resume(const TrackerOutput& last);
 
  private:
   [[nodiscard]] const PoseTracker& side(Handedness hand) const { return hand == Handedness::kLeft ? left_ : right_; }
