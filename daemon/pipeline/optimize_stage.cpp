@@ -5,9 +5,7 @@
 
 namespace handtrack::daemon {
 
-namespace {
-constexpr uint32_t bit(int slot) { return 1U << static_cast<unsigned>(slot); }
-}  // namespace
+static_assert(kMaxHands == 2, "run_slots() shares a frame's work between two hand slots");
 
 OptimizeStage::OptimizeStage(const TrackerConfig& config, TrackerReload& reload, RequestMailbox& request,
                              StageWatch& watch, bool side, std::function<void()> side_setup)
@@ -35,15 +33,8 @@ void OptimizeStage::step(Frame& f) {
   if (f.resolution_changed) tracker_->reset();
   if (f.has_input) {
     const uint32_t fitting = tracker_->begin(f.inputs);
-    const bool parallel = side_ != nullptr && (fitting & bit(0)) != 0 && (fitting & bit(1)) != 0;
-    if (parallel) {
-      side_inputs_ = &f.inputs;
-      side_->post(fit_side_);
-    }
-    for (int s = 0; s < kMaxHands; ++s) {
-      if ((fitting & bit(s)) != 0 && !(parallel && s == 1)) tracker_->fit(s, f.inputs);
-    }
-    if (parallel) side_->wait();
+    side_inputs_ = &f.inputs;
+    run_slots(fitting, side_.get(), fit_side_, [&](int s) { tracker_->fit(s, f.inputs); });
     f.output = tracker_->finish();
   } else {
     tracker_->reset();

@@ -7,6 +7,8 @@
 
 namespace handtrack::daemon {
 
+static_assert(kMaxHands == 2, "run_slots() shares a frame's work between two hand slots");
+
 PreprocessStage::PreprocessStage(const TrackerConfig& config, TrackerReload& reload, const RequestMailbox& request,
                                  const PartForest* forest, PipelineTally& tally, StageWatch& watch, bool side,
                                  std::function<void()> side_setup)
@@ -57,17 +59,9 @@ void PreprocessStage::step(Frame& f) {
     } else {
       side_request_ = request_.get();
       const uint32_t slots = f.inputs.share(f.depth, side_request_);
-      const bool parallel = side_ != nullptr && slots == 3U;
-      if (parallel) {
-        side_frame_ = &f;
-        side_->post(build_side_);
-      }
-      for (int s = 0; s < kMaxHands; ++s) {
-        if ((slots & (1U << static_cast<unsigned>(s))) != 0 && !(parallel && s == 1)) {
-          f.inputs.build_slot(s, f.depth, side_request_, forest_);
-        }
-      }
-      if (parallel) side_->wait();
+      side_frame_ = &f;
+      run_slots(slots, side_.get(), build_side_,
+                [&](int s) { f.inputs.build_slot(s, f.depth, side_request_, forest_); });
       f.has_input = true;
     }
   }

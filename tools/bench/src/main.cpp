@@ -122,23 +122,11 @@ int main(int argc, char** argv) {
         const auto t0 = std::chrono::steady_clock::now();
         request = tracker.request();
         depth = &input[static_cast<size_t>(i)];
-        const uint32_t slots = inputs.share(*depth, request);
-        const bool parallel_input = side && slots == 3U;
-        if (parallel_input) side->post(build_second);
-        for (int s = 0; s < kMaxHands; ++s) {
-          if ((slots & (1U << static_cast<unsigned>(s))) != 0 && !(parallel_input && s == 1)) {
-            inputs.build_slot(s, *depth, request, labeller);
-          }
-        }
-        if (parallel_input) side->wait();
+        SideThread* const side_thread = side ? &*side : nullptr;
+        run_slots(inputs.share(*depth, request), side_thread, build_second,
+                  [&](int s) { inputs.build_slot(s, *depth, request, labeller); });
         const auto t1 = std::chrono::steady_clock::now();
-        const uint32_t fitting = tracker.begin(inputs);
-        const bool parallel = side && fitting == 3U;
-        if (parallel) side->post(fit_second);
-        for (int s = 0; s < kMaxHands; ++s) {
-          if ((fitting & (1U << static_cast<unsigned>(s))) != 0 && !(parallel && s == 1)) tracker.fit(s, inputs);
-        }
-        if (parallel) side->wait();
+        run_slots(tracker.begin(inputs), side_thread, fit_second, [&](int s) { tracker.fit(s, inputs); });
         const HandsOutput result = tracker.finish();
         pre_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
         opt_ms.push_back(ms_since(t1));

@@ -85,4 +85,18 @@ class SideThread {
   std::thread thread_;  // last: starts after every other member is initialised
 };
 
+// One frame's work split by hand slot: `slots` has bit s set for each slot s (0 and 1) that has
+// work. With a side thread and both slots, slot 1 runs as `side_job` on the side thread while this
+// thread does `run(0)`; otherwise `run(s)` does every slot here, in order. Returns when all is done.
+// (`side_job` is a prepared std::function, so posting it allocates nothing.)
+template <typename Run>
+void run_slots(uint32_t slots, SideThread* side, const std::function<void()>& side_job, Run&& run) {
+  const bool parallel = side != nullptr && slots == 3U;
+  if (parallel) side->post(side_job);
+  for (int s = 0; s < 2; ++s) {
+    if ((slots & (1U << static_cast<unsigned>(s))) != 0 && !(parallel && s == 1)) run(s);
+  }
+  if (parallel) side->wait();
+}
+
 }  // namespace handtrack
