@@ -94,38 +94,37 @@ uint32_t HandsTracker::begin(const HandsInputs& inputs) {
     slot.trying = slot.id == 0 ? inputs.candidate(s) : std::nullopt;
     if (inputs.has(s)) fitting_ |= 1U << static_cast<unsigned>(s);
   }
-  place_obstacles();
-  // Two hands in one frame are usually a left and a right one: each slot expects to be the hand the
-  // other is not (it decides choices between left and right that its fits leave open).
-  for (int s = 0; s < max_hands_; ++s) {
-    std::optional<Handedness> expected;
-    for (int o = 0; o < max_hands_; ++o) {
-      const Slot& other = slots_[static_cast<size_t>(o)];
-      if (o == s || other.id == 0 || other.hidden_frames > 0) continue;
-      expected = other.last.handedness == Handedness::kLeft ? Handedness::kRight : Handedness::kLeft;
-    }
-    slots_[static_cast<size_t>(s)].tracker.expect(expected);
-  }
+  face_other_hands();
   return fitting_;
 }
 
-void HandsTracker::place_obstacles() {
+const HandsTracker::Slot* HandsTracker::other_seen(int s) const {
+  for (int o = 0; o < max_hands_; ++o) {
+    const Slot& other = slots_[static_cast<size_t>(o)];
+    if (o != s && other.id != 0 && other.hidden_frames == 0) return &other;  // a hidden hand's pose is old
+  }
+  return nullptr;
+}
+
+void HandsTracker::face_other_hands() {
   for (int s = 0; s < max_hands_; ++s) {
     Slot& slot = slots_[static_cast<size_t>(s)];
     slot.tracker.set_other_hand(nullptr, nullptr);
+    slot.tracker.expect(std::nullopt);
+    const Slot* other = other_seen(s);
+    if (other == nullptr) continue;
+    // Two hands in one frame are usually a left and a right one: the slot expects to be the hand
+    // the other is not (it decides choices between left and right that its fits leave open).
+    const bool other_left = other->last.handedness == Handedness::kLeft;
+    slot.tracker.expect(other_left ? Handedness::kRight : Handedness::kLeft);
     if ((fitting_ & (1U << static_cast<unsigned>(s))) == 0) continue;
-    for (int o = 0; o < max_hands_; ++o) {
-      const Slot& other = slots_[static_cast<size_t>(o)];
-      if (o == s || other.id == 0 || other.hidden_frames > 0) continue;  // a hidden hand's pose is old
-      // The other hand's last params are the right-hand model's, in the mirrored image for a left
-      // hand: posed as they are, its Gaussians are in the camera frame after mirroring x exactly
-      // when it is a left hand; a left-hand tracker of this slot wants them mirrored once more.
-      posed_.update(other.tracker.model(), other.last.params);
-      const bool other_left = other.last.handedness == Handedness::kLeft;
-      slot.other[0].assign(other.tracker.model(), posed_, other_left);
-      slot.other[1].assign(other.tracker.model(), posed_, !other_left);
-      slot.tracker.set_other_hand(&slot.other[0], &slot.other[1]);
-    }
+    // The other hand's last params are the right-hand model's, in the mirrored image for a left
+    // hand: posed as they are, its Gaussians are in the camera frame after mirroring x exactly when
+    // it is a left hand; a left-hand tracker of this slot wants them mirrored once more.
+    posed_.update(other->tracker.model(), other->last.params);
+    slot.other[0].assign(other->tracker.model(), posed_, other_left);
+    slot.other[1].assign(other->tracker.model(), posed_, !other_left);
+    slot.tracker.set_other_hand(&slot.other[0], &slot.other[1]);
   }
 }
 

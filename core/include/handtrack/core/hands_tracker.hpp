@@ -145,8 +145,11 @@ class HandsTracker {
     // tracker does (begin()).
     std::array<HandObstacle, 2> other;
   };
-  // Sets each fitting slot's obstacle: the other hand's last pose, when there is one.
-  void place_obstacles();
+  // The other slot's hand when it was seen in the last frame (not free, not hidden), else null.
+  [[nodiscard]] const Slot* other_seen(int slot) const;
+  // Each slot's view of the other hand seen in the last frame: the side it expects to be not
+  // (Tracker::expect) and, for a slot fitted this frame, the other hand's pose as an obstacle.
+  void face_other_hands();
   struct Rejected {
     Eigen::Vector3d centre;
     int frames_left = 0;
@@ -159,7 +162,7 @@ class HandsTracker {
   std::array<Rejected, kMaxHands> rejected_{};
   int rejected_count_ = 0;
   HandsInputs inputs_;    // track()'s
-  PosedHand posed_;       // place_obstacles()' scratch
+  PosedHand posed_;       // face_other_hands()' scratch
 };
 
 }  // namespace handtrack

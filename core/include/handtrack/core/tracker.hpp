@@ -309,7 +309,6 @@ class Tracker {
     settled_ = false;
     frames_since_hand_check_ = config().handedness_check_frames;
   }
-  [[nodiscard]] Handedness current_hand() const { return current_; }
   // Carry on from `last` (a pose this tracker reported) at the next frame, as if it had just been
   // tracked: HandsTracker's way back for a hand hidden behind the other, instead of a (re)start.
   void resume(const TrackerOutput& last);
