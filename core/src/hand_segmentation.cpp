@@ -91,8 +91,8 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
   const auto n = static_cast<size_t>(w) * h;
   // The surfaces this hand may be segmented from: the filtered depth, without the foreign pixels
   // (out.filtered_mm keeps them: they still hide what is behind them).
+  own_mm_.resize(n);  // on the first frame, not on the first with foreign pixels (no allocation later)
   if (foreign != nullptr && foreign->size() == n) {
-    own_mm_.resize(n);
     for (size_t i = 0; i < n; ++i) own_mm_[i] = (*foreign)[i] != 0 ? 0.0F : out.filtered_mm[i];
   }
   const auto& d = foreign != nullptr && foreign->size() == n ? own_mm_ : out.filtered_mm;

@@ -150,6 +150,9 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
   const int h = cam.height;
   const auto n = static_cast<size_t>(w) * h;
   stack_.reserve(n);  // label_surfaces' flood fill holds at most every pixel
+  // Every slot's mask sized on the first frame, not on the first frame that needs it (a pipeline
+  // frame's first second hand may come long after start-up).
+  for (auto& mask : foreign) mask.resize(n);
   // The surfaces of the median-filtered working volume (as HandSegmenter sees them: flying pixels
   // between two hands would otherwise join them).
   const std::vector<float>& median = median_.apply(depth, config.median_radius_px);
@@ -214,7 +217,6 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
   for (int s = 0; s < kMaxHands; ++s) {
     if (share[static_cast<size_t>(s)] != FrameShare::kOwn) continue;
     std::vector<uint8_t>& not_mine = foreign[static_cast<size_t>(s)];
-    not_mine.resize(n);
     const int fresh = new_surface[static_cast<size_t>(s)];
     for (int v = 0; v < h; ++v) {
       for (int u = 0; u < w; ++u) {

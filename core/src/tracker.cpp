@@ -143,6 +143,7 @@ void TrackerInputs::build(const DepthImage& depth, const InputRequest& request, 
   if (has_right_) right_.build(depth, request.right_hint, labeller, foreign);
   if (has_left_) {
     mirror_depth(depth, mirrored_);
+    mirrored_foreign_.resize(depth.depth_mm.size());  // sized with the first left hand, foreign or not
     if (foreign != nullptr) mirror_rows(*foreign, depth.camera.width, mirrored_foreign_);
     left_.build(mirrored_, request.left_hint, labeller, foreign != nullptr ? &mirrored_foreign_ : nullptr);
   }
