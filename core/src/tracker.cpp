@@ -25,8 +25,10 @@ constexpr std::array<double, 4> kStartTurns = {0.0, std::numbers::pi, 0.5 * std:
 // iterations first, and only the best few the rest of TrackerConfig::init_iterations.
 constexpr int kScreenIterations = 15;
 constexpr size_t kRefinedStarts = 3;
-// Hypotheses at most: 2 (in the image plane, along the 3D axis) x turns x closed x rotations.
-constexpr size_t kMaxStarts = 2 * kStartTurns.size() * kStartClosed.size() * kStartRotations.size();
+// Hypotheses in one plane (the image's or along the 3D axis): turns x closed x rotations; at most
+// two planes.
+constexpr size_t kStartsPerPlane = kStartTurns.size() * kStartClosed.size() * kStartRotations.size();
+constexpr size_t kMaxStarts = 2 * kStartsPerPlane;
 // A hand whose segmented axis points this much toward or away from the camera (|a_z|, the sine of
 // the angle out of the image plane: 45 deg) is also started with its fingers along that axis in 3D:
 // a hand reaching forward under a head-mounted camera, fingers pointing at a desk camera.
@@ -176,8 +178,8 @@ InputRequest Tracker::request() const {
   return r;
 }
 
-TrackerOutput Tracker::fit(Handedness hand, const DepthInput& input) {
-  TrackerOutput out = side(hand).optimise(input);
+TrackerOutput Tracker::fit(Handedness hand, const DepthInput& input, PoseTracker::CheckPace pace) {
+  TrackerOutput out = side(hand).optimise(input, pace);
   if (hand == Handedness::kLeft) {
     mirror_output(out);
     out.handedness = Handedness::kLeft;
@@ -214,11 +216,10 @@ bool Tracker::prefer(const TrackerOutput& a, const TrackerOutput& b) const {
 
 bool Tracker::both() const {
   if (config().handedness != HandednessMode::kAuto) return false;
-  // An unclear choice is re-examined every handedness_check_frames frames and at every suspect-fit
-  // check (the current hand's tracker gives no hint while it tracks only before one); a clear one
-  // is kept (a clear choice re-examined at suspect fits lost the fists of flexex1 to a left hand
-  // that explained more of the closing hand).
-  const bool due = frames_since_hand_check_ >= config().handedness_check_frames || !side(current_).hint();
+  // An unclear choice is re-examined every handedness_check_frames frames and at the start of every
+  // suspect-fit check; a clear one is kept (a clear choice re-examined at suspect fits lost the
+  // fists of flexex1 to a left hand that explained more of the closing hand).
+  const bool due = frames_since_hand_check_ >= config().handedness_check_frames || side(current_).in_doubt();
   return !tracking_ || (!settled_ && due);
 }
 
@@ -230,8 +231,12 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
   if (config().handedness == HandednessMode::kAuto && right != nullptr && left != nullptr) {
     // Both hands, each from its history (the current one while it tracks) or its (re)start
     // hypotheses; the one that explains more of the hand wins, the other starts afresh next time.
-    TrackerOutput as_right = fit(Handedness::kRight, *right);
-    TrackerOutput as_left = fit(Handedness::kLeft, *left);
+    // A check of the current hand's fit is made on this frame, not spread over the next ones: it
+    // competes with the other hand's (re)start, made on this frame too. (Spread over frames as
+    // well, the other hand's search found wrong hands that explain more of the hand than the
+    // at-once search did: docs/TRACKER.md, "Checks spread over frames".)
+    TrackerOutput as_right = fit(Handedness::kRight, *right, PoseTracker::CheckPace::kAtOnce);
+    TrackerOutput as_left = fit(Handedness::kLeft, *left, PoseTracker::CheckPace::kAtOnce);
     const bool left_wins = prefer(as_left, as_right);
     current_ = left_wins ? Handedness::kLeft : Handedness::kRight;
     side(left_wins ? Handedness::kRight : Handedness::kLeft).reset();
@@ -252,6 +257,7 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
     }
   }
   tracking_ = out.state == TrackingState::kTracking;
+  out.iterations = right_.take_iterations() + left_.take_iterations();
   out.handedness_confidence = handedness_confidence_;
   identify(out);
   return out;
@@ -284,15 +290,33 @@ void PoseTracker::reset() {
   low_confidence_run_ = 0;
   confidence_level_ = 0.0;
   check_next_ = false;
+  check_ = {};
   frames_since_check_ = 0;
 }
 
 void PoseTracker::override_pose(const PoseParams& pose) {
   previous_ = pose;
   before_previous_ = pose;
+  check_ = {};
+}
+
+PoseTracker::Start PoseTracker::start_at(size_t k) {
+  // The order of restart()'s loops: plane, turn, closed, rotation.
+  const size_t in_plane = k % kStartsPerPlane;
+  Start start;
+  start.along_axis_3d = k >= kStartsPerPlane;
+  start.turn_rad = kStartTurns[in_plane / (kStartClosed.size() * kStartRotations.size())];
+  start.closed = kStartClosed[(in_plane / kStartRotations.size()) % kStartClosed.size()];
+  start.in_plane_offset_rad = kStartRotations[in_plane % kStartRotations.size()];
+  return start;
+}
+
+size_t PoseTracker::start_count(const HandPlace& place) {
+  return std::abs(place.finger_axis.z()) >= kOutOfPlaneAxisMinZ ? kMaxStarts : kStartsPerPlane;
 }
 
 std::optional<HandHint> PoseTracker::hint() const {
+  // A check's hypotheses are placed on a freshly segmented hand, not where the doubted pose says.
   if (!previous_ || check_next_) return std::nullopt;
   // Only the global transform matters (no PosedHand: nothing is allocated on the hot path).
   const Vector3d t = previous_->segment<3>(kTranslationParam);
@@ -300,12 +324,12 @@ std::optional<HandHint> PoseTracker::hint() const {
   return HandHint{t + camera_R_hand * model_.palm_centre(), t, camera_R_hand * Vector3d::UnitY()};
 }
 
-PoseParams PoseTracker::initial_pose(const DepthInput& input, const Start& start) const {
+PoseParams PoseTracker::initial_pose(const HandPlace& place, const Start& start) const {
   // Frontal open hand (r = 0: fingers toward -y in the image) turned in the image plane onto the
   // hand's axis: rotation phi about the camera z maps (0,-1) to (sin phi, -cos phi). The back of
   // the hand faces the camera after half a turn about the finger axis (the camera y axis at r = 0)
   // first: R = Rz(phi) Ry(pi).
-  const Vector3d& axis = input.finger_axis;
+  const Vector3d& axis = place.finger_axis;
   const double phi = std::atan2(axis.x(), -axis.y()) + start.in_plane_offset_rad;
   PoseParams params = PoseParams::Zero();
   Eigen::Matrix3d turn = Eigen::AngleAxisd(phi, Vector3d::UnitZ()).toRotationMatrix() *
@@ -340,7 +364,7 @@ PoseParams PoseTracker::initial_pose(const DepthInput& input, const Start& start
   const double facing = std::abs(std::cos(start.turn_rad));
   const double behind_surface = facing * palm_half_thickness + (1.0 - facing) * palm_half_width +
                                 (start.closed ? palm_toward * kClosedFingersInFrontMm : 0.0);
-  const Vector3d target = input.palm_centre_mm + Vector3d(0, 0, behind_surface);
+  const Vector3d target = place.palm_centre_mm + Vector3d(0, 0, behind_surface);
   const Vector3d centre = at_origin.camera_R_hand() * model_.palm_centre();
   params.segment<3>(kTranslationParam) = target - centre;
   return params;
@@ -417,7 +441,7 @@ PoseTracker::Explained PoseTracker::explain(const DepthInput& input, const Posed
   return {coverage * (1.0 - static_cast<double>(bad) / std::max(1, m)), labelled > 0.0 ? agreeing / labelled : -1.0};
 }
 
-TrackerOutput PoseTracker::optimise(const DepthInput& input) {
+TrackerOutput PoseTracker::optimise(const DepthInput& input, CheckPace pace) {
   const auto no_hand = [&]() {
     reset();
     recovering_ = true;
@@ -447,6 +471,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
       for (int j = 0; j < kNumPoseParams; ++j) particle[j] += alpha(rng_) * velocity[j];
       const bool guided = fuse && i == config_.particles - 1;
       auto r = optimizer_.maximise(guided ? guided_energy_ : energy_, frame, particle, scratch_);
+      iterations_ += config_.optimizer.iterations;
       // Late fusion (Sec. 5): "the pose particle which converges with the best energy value is
       // chosen". The particles optimise different energies, so each is judged by one common energy.
       if (fuse) r.energy = common_energy_.evaluate(frame, r.params, scratch_, nullptr);
@@ -461,14 +486,24 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   scratch_.update(model_, best.params);
   Explained explained = explain(input, scratch_);
   if (check_next_ && previous_) {
-    // A suspected gross error: the tracked pose competes with the (re)start hypotheses on this
-    // freshly segmented frame; a (re)start replaces it only when it explains more of the hand, so
-    // a check cannot make good tracking worse by this measure.
-    const Fit fresh = restart(input);
-    check = fresh.explained.score() > explained.score() ? CheckOutcome::kRestartWon : CheckOutcome::kTrackedKept;
-    if (check == CheckOutcome::kRestartWon) {
-      best = fresh.result;
-      explained = fresh.explained;
+    // The hypotheses are placed on this frame's hand, segmented afresh (hint()), not where the
+    // doubted pose says; the later frames of the check are segmented with the hint again (a fresh
+    // segmentation on each of them lost the hand in one of them: docs/TRACKER.md).
+    const HandPlace place{input.palm_centre_mm, input.finger_axis};
+    check_ = Check{true, place, input.hand_centroid_mm, start_count(place), 0, 0};
+    screened_.clear();
+    check_next_ = false;
+  }
+  if (check_.active) {
+    // A suspected gross error: the tracked pose competes with the (re)start hypotheses, searched
+    // for over the next frames (continue_check); a (re)start replaces it only when it explains
+    // more of the hand on the same frame, so a check cannot make good tracking worse by this
+    // measure.
+    const std::optional<Fit> fresh = continue_check(input, explained, pace);
+    check = fresh ? CheckOutcome::kRestartWon : check_.active ? CheckOutcome::kChecking : CheckOutcome::kTrackedKept;
+    if (fresh) {
+      best = fresh->result;
+      explained = fresh->explained;
       winner = -1;
       guided_won = false;
       before_previous_.reset();  // no velocity from the wrong pose to the restart
@@ -506,6 +541,56 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   return out;
 }
 
+PoseTracker::Fit PoseTracker::fit_from(const DepthInput& input, const PoseParams& from, int iterations,
+                                        const PoseEnergy& with) {
+  const EnergyFrame frame{&model_, &input, nullptr, nullptr, other_hand_};
+  const auto r = optimizer_.maximise(with, frame, from, scratch_, iterations);
+  iterations_ += iterations;
+  scratch_.update(model_, r.params);
+  return Fit{r, explain(input, scratch_)};
+}
+
+const PoseEnergy& PoseTracker::start_energy(const DepthInput& input) const {
+  return fuses(input) ? guided_energy_ : energy_;
+}
+
+PoseTracker::Fit PoseTracker::screen(const DepthInput& input, const HandPlace& place, size_t k) {
+  return fit_from(input, initial_pose(place, start_at(k)), std::min(kScreenIterations, config_.init_iterations),
+                  start_energy(input));
+}
+
+void PoseTracker::keep_best_screened(const DepthInput& input) {
+  // The kRefinedStarts best by fit score go on, each with the start energy and, with late fusion,
+  // also with the depth-only energy: on real depth the forest (trained on renders) mislabels, and
+  // the guided energy alone fitted 3 of 7 SR305 frames as the other hand (docs/TRACKER.md, "Real
+  // frames").
+  const auto kept = std::min(kRefinedStarts, screened_.size());
+  std::partial_sort(screened_.begin(), screened_.begin() + static_cast<std::ptrdiff_t>(kept), screened_.end(),
+                    better);
+  screened_.resize(kept);
+  if (&start_energy(input) != &energy_) {
+    for (size_t k = 0; k < kept; ++k) screened_.push_back(screened_[k]);
+  }
+}
+
+PoseTracker::Fit PoseTracker::refine(const DepthInput& input, int iterations) {
+  // screened_ after keep_best_screened(): the start energy's candidates first, then (late fusion)
+  // the depth-only ones.
+  Fit best;
+  for (size_t k = 0; k < screened_.size(); ++k) {
+    const PoseEnergy& with = k < kRefinedStarts ? start_energy(input) : energy_;
+    screened_[k] = iterations > 0 ? fit_from(input, screened_[k].result.params, iterations, with) : screened_[k];
+    if (better(screened_[k], best)) best = screened_[k];
+  }
+  return best;
+}
+
+bool PoseTracker::better(const Fit& a, const Fit& b) {
+  // By score; on a tie (the same share explained), by energy.
+  return a.explained.score() > b.explained.score() + 1e-9 ||
+         (a.explained.score() > b.explained.score() - 1e-9 && a.result.energy > b.result.energy);
+}
+
 PoseTracker::Fit PoseTracker::restart(const DepthInput& input) {
   // The hypotheses are compared by confidence, not energy: E_sim has no notion of occlusion, so
   // a wrong pose that pushes the big palm Gaussians onto the visible surface can out-score the right
@@ -517,48 +602,42 @@ PoseTracker::Fit PoseTracker::restart(const DepthInput& input) {
   //
   // Successive halving: every hypothesis gets kScreenIterations, then only the kRefinedStarts best
   // (by fit score) get the rest of init_iterations. All hypotheses to the end cost 24-48 x 80
-  // iterations, 40-100 ms on one frame at every start and suspect-fit check.
-  const EnergyFrame frame{&model_, &input, nullptr, nullptr, other_hand_};
-  const PoseEnergy& energy = fuses(input) ? guided_energy_ : energy_;
-  const bool out_of_plane = std::abs(input.finger_axis.z()) >= kOutOfPlaneAxisMinZ;
-  const auto fit = [&](const PoseParams& from, int iterations, const PoseEnergy& with) {
-    const auto r = optimizer_.maximise(with, frame, from, scratch_, iterations);
-    scratch_.update(model_, r.params);
-    return Fit{r, explain(input, scratch_)};
-  };
-  // Better by score; on a tie (the same share explained), by energy.
-  const auto better = [](const Fit& a, const Fit& b) {
-    return a.explained.score() > b.explained.score() + 1e-9 ||
-           (a.explained.score() > b.explained.score() - 1e-9 && a.result.energy > b.result.energy);
-  };
+  // iterations, 40-100 ms on one frame at every start (and check made at once).
   screened_.clear();
-  for (bool along_axis_3d : {false, true}) {
-    if (along_axis_3d && !out_of_plane) continue;
-    for (double turn : kStartTurns) {
-      for (bool closed : kStartClosed) {
-        for (double offset : kStartRotations) {
-          const Start start{offset, closed, turn, along_axis_3d};
-          screened_.push_back(fit(initial_pose(input, start), std::min(kScreenIterations, config_.init_iterations), energy));
-        }
-      }
-    }
+  const HandPlace place{input.palm_centre_mm, input.finger_axis};
+  for (size_t k = 0; k < start_count(place); ++k) screened_.push_back(screen(input, place, k));
+  keep_best_screened(input);
+  return refine(input, config_.init_iterations - kScreenIterations);
+}
+
+std::optional<PoseTracker::Fit> PoseTracker::continue_check(const DepthInput& input, const Explained& tracked,
+                                                            CheckPace pace) {
+  // restart()'s search, about check_iterations_per_frame iterations a frame: hypotheses screened on each
+  // frame (placed where the check's first frame found the hand), then the best refined together, each
+  // frame continuing from the last (the hand moves meanwhile), and the best of them compared with
+  // the tracked pose on the last frame.
+  const int per_frame_iterations = config_.check_iterations_per_frame;
+  const bool at_once = pace == CheckPace::kAtOnce || per_frame_iterations <= 0;
+  if (check_.screened < check_.starts) {
+    const auto per_frame = static_cast<size_t>(std::max(1, per_frame_iterations / kScreenIterations));
+    const size_t end = at_once ? check_.starts : std::min(check_.starts, check_.screened + per_frame);
+    // Placed where the check's first frame found the hand, moved as the segmented hand's centroid
+    // has moved since.
+    HandPlace place = check_.place;
+    place.palm_centre_mm += input.hand_centroid_mm - check_.centroid_mm;
+    for (; check_.screened < end; ++check_.screened) screened_.push_back(screen(input, place, check_.screened));
+    if (check_.screened == check_.starts) keep_best_screened(input);
+    if (!at_once) return std::nullopt;
   }
-  const auto refined = std::min(kRefinedStarts, screened_.size());
-  std::partial_sort(screened_.begin(), screened_.begin() + static_cast<std::ptrdiff_t>(refined), screened_.end(), better);
-  Fit best;
-  for (size_t k = 0; k < refined; ++k) {
-    const int rest = config_.init_iterations - kScreenIterations;
-    const Fit f = rest > 0 ? fit(screened_[k].result.params, rest, energy) : screened_[k];
-    if (better(f, best)) best = f;
-    if (&energy != &energy_ && rest > 0) {
-      // With late fusion each is refined with the depth-only energy as well: on real depth the
-      // forest (trained on renders) mislabels, and its energy alone fitted 3 of 7 SR305 frames
-      // as the other hand (docs/TRACKER.md, "Real frames").
-      const Fit g = fit(screened_[k].result.params, rest, energy_);
-      if (better(g, best)) best = g;
-    }
-  }
-  return best;
+  const int rest = std::max(0, config_.init_iterations - kScreenIterations) - check_.refined;
+  const int slice = std::max(1, per_frame_iterations / static_cast<int>(screened_.size()));
+  const bool last = at_once || slice >= rest;
+  const int iterations = last ? rest : slice;
+  check_.refined += iterations;
+  const Fit best = refine(input, iterations);
+  if (!last) return std::nullopt;
+  check_.active = false;
+  return best.explained.score() > tracked.score() ? std::optional<Fit>(best) : std::nullopt;
 }
 
 void PoseTracker::watch_confidence(double conf, CheckOutcome check) {
@@ -576,7 +655,7 @@ void PoseTracker::watch_confidence(double conf, CheckOutcome check) {
     confidence_level_ += config_.confidence_level_rate * (conf - confidence_level_);
   }
   frames_since_check_ = check == CheckOutcome::kNone ? frames_since_check_ + 1 : 0;
-  check_next_ = suspect && frames_since_check_ >= config_.check_interval_frames;
+  check_next_ = suspect && !check_.active && frames_since_check_ >= config_.check_interval_frames;
 }
 
 bool PoseTracker::fuses(const DepthInput& input) const {

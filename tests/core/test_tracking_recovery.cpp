@@ -90,6 +90,63 @@ TEST(TrackingRecovery, BackWithin30FramesAfterAGrossError) {
   }
 }
 
+// Checks spread over frames (TrackerConfig::check_iterations_per_frame, the latency setting): a
+// frame that follows a tracked frame runs tracking's particles and at most about
+// check_iterations_per_frame more, never a whole (re)start search; only a frame with no pose to go
+// on (the start, a lost fit) searches at once. One hand's tracker (handedness fixed): in auto
+// handedness an unclear choice of hand is still re-examined at once (docs/TRACKER.md, "Checks
+// spread over frames"). Knocked off as above, the tracker is back within 30 frames after most
+// knocks, not all: measured 8 of 9, random's knock after frame 140 (its fast half) is not back
+// within 30 frames, where checks made at once have it back after 2 (the test fails with
+// check_iterations_per_frame 0: the frames after the knocks stall on whole searches).
+TEST(TrackingRecovery, ChecksSpreadOverFramesKeepEveryFrameShortAndStillRepairAGrossError) {
+  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  TrackerConfig config = testing::paper_config(EnergyMode::kLateFusion);
+  config.handedness = HandednessMode::kRight;
+  config.check_iterations_per_frame = 64;
+  const int tracking_iterations = config.particles * config.optimizer.iterations;
+  const int most_after_tracked = tracking_iterations + config.check_iterations_per_frame;
+  constexpr int kMostKnocksBack = 7;  // of 3 motions x 3 knocks
+  int knocks_back = 0;
+  std::mt19937_64 rng(5);
+  for (const auto motion : {"random", "flexex1", "fingercount"}) {
+    auto camera = testing::motion_camera(motion);
+    Tracker undisturbed(config);
+    Tracker knocked(config);
+    std::vector<double> undisturbed_mm;
+    std::vector<double> knocked_mm;
+    synth::SynthFrame frame;
+    TrackingState last_state = TrackingState::kNoHand;
+    int checking_frames = 0;
+    for (int i = 0; i < kSequenceFrames; ++i) {
+      camera.render(i, frame);
+      undisturbed_mm.push_back(eval::fingertip_error_mm(undisturbed.track(frame.depth, &forest), frame.fingertips));
+      const auto out = knocked.track(frame.depth, &forest);
+      knocked_mm.push_back(eval::fingertip_error_mm(out, frame.fingertips));
+      if (i == 0) {
+        EXPECT_GT(out.iterations, most_after_tracked) << motion << ": the start searches at once";
+      }
+      if (last_state == TrackingState::kTracking) {
+        EXPECT_LE(out.iterations, most_after_tracked) << motion << " frame " << i << " stalls on a whole search";
+        checking_frames += out.iterations > tracking_iterations ? 1 : 0;
+      }
+      last_state = out.state;
+      if (std::find(kKnockFrames.begin(), kKnockFrames.end(), i) != kKnockFrames.end()) {
+        auto& pose = knocked.pose_tracker();
+        pose.override_pose(knocked_off(out.params, pose.model(), rng));
+      }
+    }
+    const auto recovered = frames_to_recover(knocked_mm, undisturbed_mm);
+    for (size_t n = 0; n < recovered.size(); ++n) {
+      std::printf("%-12s knocked off after frame %3d: back after %d frames\n", motion, kKnockFrames[n], recovered[n]);
+      knocks_back += recovered[n] >= 1 ? 1 : 0;
+    }
+    std::printf("%-12s frames with a check under way: %d\n", motion, checking_frames);
+    EXPECT_GT(checking_frames, 0) << motion << ": the knocks were never checked";
+  }
+  EXPECT_GE(knocks_back, kMostKnocksBack) << "knocks repaired within 30 frames";
+}
+
 // No hand: the state says so, and every number of the pose is zero (nothing invented).
 void expect_no_hand(const TrackerOutput& out, const std::string& what) {
   EXPECT_EQ(out.state, TrackingState::kNoHand) << what;

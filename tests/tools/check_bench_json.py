@@ -11,7 +11,8 @@ with open(out) as f:
     table = json.load(f)
 failures = []
 TWO_HANDS = ("two_hands_late_fusion_2p_10it", "two_hands_late_fusion_2p_10it_one_thread")
-for name in ("depth_only_1p_10it", "depth_only_2p_10it", "late_fusion_2p_10it", "late_fusion_2p_10it_max_hands_2") + TWO_HANDS:
+SPREAD_CHECKS = ("depth_only_2p_10it_spread_checks", "late_fusion_2p_10it_spread_checks")
+for name in ("depth_only_1p_10it", "depth_only_2p_10it", "late_fusion_2p_10it", "late_fusion_2p_10it_max_hands_2") + TWO_HANDS + SPREAD_CHECKS:
     entry = table.get(name)
     if entry is None:
         failures.append(f"{name}: missing")

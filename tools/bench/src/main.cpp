@@ -37,6 +37,7 @@ struct BenchConfig {
   int max_hands = 1;
   bool two_hand_input = false;  // the two-hand scene, else the one-hand motion
   bool side_thread = false;     // a frame's second hand (preprocessing, optimisation) on a SideThread
+  int check_iterations_per_frame = 0;  // TrackerConfig's: 0 checks at once, N spread over frames
 };
 
 // Renders `frames` depth frames of `motion` (seed 7, noise, 320x240).
@@ -90,7 +91,10 @@ int main(int argc, char** argv) {
         {"late_fusion_2p_10it", EnergyMode::kLateFusion, 2, 10},
         {"late_fusion_2p_10it_max_hands_2", EnergyMode::kLateFusion, 2, 10, 2},
         {"two_hands_late_fusion_2p_10it", EnergyMode::kLateFusion, 2, 10, 2, true, true},
-        {"two_hands_late_fusion_2p_10it_one_thread", EnergyMode::kLateFusion, 2, 10, 2, true, false}};
+        {"two_hands_late_fusion_2p_10it_one_thread", EnergyMode::kLateFusion, 2, 10, 2, true, false},
+        // The latency setting: checks spread over frames at 64 iterations a frame.
+        {"depth_only_2p_10it_spread_checks", EnergyMode::kDepthOnly, 2, 10, 1, false, false, 64},
+        {"late_fusion_2p_10it_spread_checks", EnergyMode::kLateFusion, 2, 10, 1, false, false, 64}};
     nlohmann::json out = nlohmann::json::object();
     tools::Progress progress(kProgram);
     std::printf("%-40s %8s %14s %12s %16s %8s\n", "configuration", "fps", "preprocess_ms", "optimize_ms",
@@ -102,6 +106,7 @@ int main(int argc, char** argv) {
       tc.particles = bc.particles;
       tc.optimizer.iterations = bc.iterations;
       tc.max_hands = bc.max_hands;
+      tc.check_iterations_per_frame = bc.check_iterations_per_frame;
       // The shipped tracker (handedness auto), its two steps timed apart.
       HandsInputs inputs(tc.input);
       HandsTracker tracker(tc);

@@ -18,6 +18,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <utility>
 
 namespace handtrack {
 
@@ -81,6 +82,13 @@ struct TrackerConfig {
   double suspect_confidence_ratio = 0.75;
   double confidence_level_rate = 0.1;
   int check_interval_frames = 5;
+  // 0: a check is made on one frame (10-16 ms here). N > 0: spread over frames at about N optimiser
+  // iterations per frame on top of tracking (PoseTracker::continue_check): at 64, 4 hypotheses
+  // screened per frame, then each kept one refined by 21 (depth-only) or 10 (late fusion)
+  // iterations, 10-19 frames in all. A latency setting: spread checks keep every tracked frame
+  // within about 3 ms, but repair a gross error in about 14 frames instead of 2 and cost the
+  // broadened benchmark 0.5 mm (docs/TRACKER.md, "Checks spread over frames").
+  int check_iterations_per_frame = 0;
   // A (re)start must explain at least this much of the segmented surface, or there is no hand.
   double min_start_confidence = 0.6;
   // Auto handedness (Tracker; ours): a hand chosen by less than this confidence margin is not
@@ -123,6 +131,10 @@ struct TrackerOutput {
   double pinch_distance_mm = 0.0;    // thumb tip to index tip, surface to surface
   double pinch_strength = 0.0;       // 1 = touching, 0 = apart (>= 40 mm)
   int winning_particle = -1;         // -1: a (re)start, not a particle
+  // Optimiser iterations this frame took, both hands' trackers together (Tracker): 2 x 10 while
+  // it tracks, a few dozen more while a check spread over frames runs, hundreds at a (re)start and
+  // at a check made at once.
+  int iterations = 0;
   bool detection_guided_won = false;  // late fusion: the detection-guided particle won
   Handedness handedness = Handedness::kRight;
   // How clearly the last choice of hand was made, in [0, 1]: the chosen hand's confidence minus
@@ -145,14 +157,22 @@ double fit_score(double confidence, double label_agreement);
 
 class PoseTracker {
  public:
+
   explicit PoseTracker(TrackerConfig config = {});
 
   // Where segmentation should look for the hand in the next frame: none before the first pose,
   // after the fit was lost, and before a check against a (re)start (the next frame is segmented
   // afresh). Allocates nothing.
   [[nodiscard]] std::optional<HandHint> hint() const;
+  // Optimiser iterations since the last call (TrackerOutput::iterations).
+  int take_iterations() { return std::exchange(iterations_, 0); }
+  // No tracked pose, or the next frame starts a check of it (a suspect fit, below).
+  [[nodiscard]] bool in_doubt() const { return !previous_ || check_next_; }
   // Optimises the pose for one frame's C_I and updates the history.
-  TrackerOutput optimise(const DepthInput& input);
+  // How a check of a suspect fit is made: its search spread over the next frames (the fit stays
+  // the tracked one meanwhile; TrackerConfig::check_iterations_per_frame > 0), or all on this frame.
+  enum class CheckPace { kSpread, kAtOnce };
+  TrackerOutput optimise(const DepthInput& input, CheckPace pace = CheckPace::kSpread);
   // Forget the history: the next frame starts from the open hand.
   void reset();
   // Replaces the tracker's belief about the last pose (both previous poses) by `pose`: how tests
@@ -174,7 +194,12 @@ class PoseTracker {
     double turn_rad = 0.0;
     bool along_axis_3d = false;        // fingers along the segmented axis in 3D, not in the image plane
   };
-  [[nodiscard]] PoseParams initial_pose(const DepthInput& input, const Start& start) const;
+  // Where a (re)start places its hypotheses: the segmented hand's palm centre and finger axis.
+  struct HandPlace {
+    Eigen::Vector3d palm_centre_mm = Eigen::Vector3d::Zero();
+    Eigen::Vector3d finger_axis = Eigen::Vector3d(0, -1, 0);
+  };
+  [[nodiscard]] PoseParams initial_pose(const HandPlace& place, const Start& start) const;
   // How much of the segmented hand the posed model explains, in [0, 1].
   [[nodiscard]] double confidence(const DepthInput& input, const PosedHand& hand) const;
   struct Explained {
@@ -195,9 +220,24 @@ class PoseTracker {
   };
   // Sec. 5's start: the (re)start hypotheses optimised on `input`, the best by fit score.
   Fit restart(const DepthInput& input);
+  // The pieces of restart() (successive halving): the hypotheses in order, how many a frame gets
+  // (24, or 48 for a hand out of the image plane), the k-th screened, the best kept, and their
+  // refinement.
+  static Start start_at(size_t k);
+  static size_t start_count(const HandPlace& place);
+  Fit fit_from(const DepthInput& input, const PoseParams& from, int iterations, const PoseEnergy& with);
+  [[nodiscard]] const PoseEnergy& start_energy(const DepthInput& input) const;
+  Fit screen(const DepthInput& input, const HandPlace& place, size_t k);
+  void keep_best_screened(const DepthInput& input);
+  // Every kept hypothesis `iterations` further on `input`; the best.
+  Fit refine(const DepthInput& input, int iterations);
+  static bool better(const Fit& a, const Fit& b);
+  // A suspect-fit check, one slice of the (re)start search per frame: the fit that replaces the
+  // tracked pose (`tracked`: how well it explains this frame), or nullopt.
+  std::optional<Fit> continue_check(const DepthInput& input, const Explained& tracked, CheckPace pace);
   // After a frame's fit: tracks the running confidence level and decides whether the next frame
   // checks the tracked pose against a (re)start.
-  enum class CheckOutcome { kNone, kTrackedKept, kRestartWon };
+  enum class CheckOutcome { kNone, kChecking, kTrackedKept, kRestartWon };
   void watch_confidence(double confidence, CheckOutcome check);
   // Late fusion with part labels on the leaves.
   [[nodiscard]] bool fuses(const DepthInput& input) const;
@@ -219,8 +259,17 @@ class PoseTracker {
   int low_confidence_run_ = 0;
   bool recovering_ = false;
   double confidence_level_ = 0.0;     // running level of the tracked pose's confidence
-  bool check_next_ = false;           // the next frame: fresh segmentation and a (re)start too
+  bool check_next_ = false;           // the next frame starts a check (continue_check)
+  struct Check {
+    bool active = false;
+    HandPlace place;      // of the check's first frame
+    Eigen::Vector3d centroid_mm = Eigen::Vector3d::Zero();  // of its segmented hand
+    size_t starts = 0;    // hypotheses to screen
+    size_t screened = 0;  // of them so far (screened_)
+    int refined = 0;      // refinement iterations done (of each kept hypothesis)
+  } check_;
   int frames_since_check_ = 0;
+  int iterations_ = 0;  // take_iterations()
 };
 
 // What the next frame's preprocessing should build for a Tracker: the inputs of the hands it will
@@ -267,10 +316,11 @@ class TrackerInputs {
 // fingertips, palm centre and normal are mirrored back (x negated); `params` stay those of the
 // right-hand model in the mirrored image. With HandednessMode::kAuto both hands are fitted at
 // every (re)start (no hand yet, lost, recovering) and the one that explains more of the hand
-// (confidence) is kept; while it tracks, only it runs, except on checks: the tracked hand then
+// (fit score) is kept; while it tracks, only it runs, except on checks: the tracked hand then
 // competes with the other hand's (re)start, which replaces it when it explains more. Checks come
 // only while the last choice was not clear (TrackerConfig::handedness_margin): every
-// handedness_check_frames frames and with every suspect fit (PoseTracker's gross-error check).
+// handedness_check_frames frames and at the start of every suspect-fit check (PoseTracker's
+// gross-error check, which is then made at once, not spread over frames).
 //
 // Threading: request() and optimise() on one thread; TrackerInputs::build() anywhere, on inputs
 // the optimising thread does not read at the time.
@@ -320,7 +370,8 @@ class Tracker {
   [[nodiscard]] bool both() const;
   // Whether hand `a` is the better fit of the frame than hand `b`.
   [[nodiscard]] bool prefer(const TrackerOutput& a, const TrackerOutput& b) const;
-  TrackerOutput fit(Handedness hand, const DepthInput& input);
+  TrackerOutput fit(Handedness hand, const DepthInput& input,
+                    PoseTracker::CheckPace pace = PoseTracker::CheckPace::kSpread);
   void identify(TrackerOutput& out);  // sets out.hand_id
 
   PoseTracker right_;
