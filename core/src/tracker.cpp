@@ -301,7 +301,8 @@ void PoseTracker::override_pose(const PoseParams& pose) {
 }
 
 PoseTracker::Start PoseTracker::start_at(size_t k) {
-  // The order of restart()'s loops: plane, turn, closed, rotation.
+  // Hypothesis k: by plane (the image's, then along the 3D axis), turn, closed, and in-plane
+  // rotation, the last changing fastest.
   const size_t in_plane = k % kStartsPerPlane;
   Start start;
   start.along_axis_3d = k >= kStartsPerPlane;

@@ -20,8 +20,9 @@
 // keeps its id and last pose, unreported, for TrackerConfig::hidden_hand_frames frames, and looks
 // for the hand where it was last seen: when it shows again near there it is the same hand. A hand
 // that finds no fit with no other hand in view, or stays away longer, has left: its slot is freed
-// and its id never given out again, so a hand that comes back has a fresh id and a fresh start. Where two hands are fitted the other
-// hand's last pose is an obstacle for each (EnergyFrame::other_hand, E_col between the hands).
+// and its id never given out again, so a hand that comes back has a fresh id and a fresh start.
+// Where two hands are fitted the other hand's last pose is an obstacle for each
+// (EnergyFrame::other_hand, E_col between the hands).
 //
 // Threading: like Tracker, request() / begin() / finish() on one thread; fit(slot) of different
 // slots may run on different threads at once between begin() and finish() (the slots share no

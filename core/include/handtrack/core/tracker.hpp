@@ -157,7 +157,6 @@ double fit_score(double confidence, double label_agreement);
 
 class PoseTracker {
  public:
-
   explicit PoseTracker(TrackerConfig config = {});
 
   // Where segmentation should look for the hand in the next frame: none before the first pose,
