@@ -1,5 +1,6 @@
 // DepthInputBuilder: the four steps from a depth image to C_I (paper Sec. 3.1, 4), each in its own
-// unit: median_filter, hand_segmentation, quadtree, image_self_similarity.
+// unit: median_filter, hand_segmentation, quadtree, image_self_similarity; and the free space around
+// the hand (free_space, ours).
 #include "handtrack/core/depth_input.hpp"
 
 #include "hand_segmentation.hpp"
@@ -46,6 +47,7 @@ const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::o
     out_.filtered_mm[i] = (m >= near && m <= far) ? m : 0.0F;
   }
   steps_->segmenter.segment(config_, median, hint, out_, foreign);
+  out_.free_space.build(out_.camera, median, out_.hand_mask, config_.free_space);
   out_.pixel_labels.clear();
   if (labeller != nullptr && out_.hand_pixels > 0) labeller->label(out_, out_.pixel_labels);
   steps_->quadtree.build(config_, steps_->segmenter.hand_box(), out_);

@@ -342,6 +342,48 @@ double InterHandCollisionTerm::evaluate_centres(const HandModel& model, const Po
   return energy * inv_norm;
 }
 
+namespace {
+constexpr double kFreeSpaceSlackMm = 5.0;   // s of E_free
+constexpr double kFreeSpaceScaleMm = 10.0;  // l of E_free
+}  // namespace
+
+double FreeSpaceTerm::evaluate(const PosedHand& hand, const DepthInput& input, PoseGradient* gradient) const {
+  return chain_to_pose(hand, gradient,
+                       [&](CentreGradients* dE_dcentres) { return evaluate_centres(hand, input, dE_dcentres); });
+}
+
+double FreeSpaceTerm::evaluate_centres(const PosedHand& hand, const DepthInput& input,
+                                       CentreGradients* dE_dcentres) const {
+  const FreeSpaceMap& map = input.free_space;
+  const int n = hand.gaussian_count();
+  if (map.empty() || n == 0) return 0.0;
+  const auto& cam = input.camera;
+  const double f = cam.focal();
+  const double inv_norm = 1.0 / (n * kFreeSpaceScaleMm * kFreeSpaceScaleMm);
+  double energy = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const Vector3d& mu = hand.centre(i);
+    const double z = mu.z();
+    if (z < 1.0) continue;  // behind or at the camera: no projection
+    const double u = cam.fx * mu.x() / z + cam.cx;
+    const double v = cam.fy * mu.y() / z + cam.cy;
+    const FreeSpaceMap::Sample d = map.sample(u, v);
+    const double excess = d.distance_px * z / f - kFreeSpaceSlackMm;
+    if (excess <= 0.0) continue;
+    energy += excess * excess;
+    if (dE_dcentres == nullptr) continue;
+    const double de_dr = 2.0 * excess * inv_norm;
+    const double dr_du = z / f * d.d_du;
+    const double dr_dv = z / f * d.d_dv;
+    Vector3d dr_dmu;
+    dr_dmu.x() = dr_du * cam.fx / z;
+    dr_dmu.y() = dr_dv * cam.fy / z;
+    dr_dmu.z() = d.distance_px / f - dr_du * cam.fx * mu.x() / (z * z) - dr_dv * cam.fy * mu.y() / (z * z);
+    dE_dcentres->col(i) += de_dr * dr_dmu;
+  }
+  return energy * inv_norm;
+}
+
 double JointLimitTerm::evaluate(const HandModel& model, const PoseParams& params, PoseGradient* gradient) const {
   double energy = 0.0;
   for (int j = 0; j < kNumJointAngles; ++j) {
@@ -400,6 +442,11 @@ double PoseEnergy::evaluate(const EnergyFrame& frame, const PoseParams& params, 
   if (weights_.smoothness != 0.0 && frame.previous != nullptr && frame.before_previous != nullptr) {
     e.smoothness = smoothness_.evaluate(params, *frame.previous, *frame.before_previous, want ? &g_smo : nullptr);
   }
+  CentreGradients g_free;
+  if (weights_.free_space != 0.0) {
+    if (want) g_free = CentreGradients::Zero(3, n);
+    e.free_space = free_space_.evaluate_centres(hand, *frame.input, want ? &g_free : nullptr);
+  }
   // E_hand only with another hand: without one, the sums (and their rounding) are exactly eq. 2's.
   const bool other_hand = frame.other_hand != nullptr && weights_.inter_hand != 0.0;
   CentreGradients g_hand;
@@ -410,10 +457,12 @@ double PoseEnergy::evaluate(const EnergyFrame& frame, const PoseParams& params, 
   e.total = e.similarity - weights_.collision * e.collision - weights_.limits * e.limits -
             weights_.smoothness * e.smoothness;
   if (other_hand) e.total -= weights_.inter_hand * e.inter_hand;
+  if (weights_.free_space != 0.0) e.total -= weights_.free_space * e.free_space;
   if (want) {
     *gradient = -weights_.limits * g_lim - weights_.smoothness * g_smo;
     g_sim -= weights_.collision * g_col;
     if (other_hand) g_sim -= weights_.inter_hand * g_hand;
+    if (weights_.free_space != 0.0) g_sim -= weights_.free_space * g_free;
     hand.add_centre_gradients(g_sim, *gradient);
   }
   if (breakdown != nullptr) *breakdown = e;

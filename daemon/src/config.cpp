@@ -187,6 +187,8 @@ const std::vector<Field>& fields() {
      "w_s, weight of the smoothness term E_smo (Sec. 4.1: 1.0)", true},
     {"tracker.energy.w_h", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.inter_hand; }}, 0, 1000,
      "w_h, weight of the collision term between two hands E_hand (ours: the paper tracks one hand)", true},
+    {"tracker.energy.w_f", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.free_space; }}, 0, 1000,
+     "w_f, weight of the free-space term E_free: model parts over the background (ours, late fusion only; 0 = the paper's energy)", true},
     {"tracker.energy.label_radius_mm", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.label_radius_mm; }}, 1, 5000,
      "R_i, radius of influence of the label similarity factor (Sec. 4.3: 200 mm)", true},
     {"tracker.energy.smoothness_translation_per_mm", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.smoothness_translation_per_mm; }}, 0, 1,

@@ -46,6 +46,38 @@ DepthInput synthetic_input(const HandModel& model, const PoseParams& pose, std::
   return in;
 }
 
+// The depth a camera sees of the model at `pose` in front of a wall 200 mm behind it (free space
+// for E_free): each Gaussian a disc of radius sigma_p at depth z - sigma_h, the nearest in front;
+// the discs are the hand's mask. Sets input.free_space.
+void add_silhouette(const HandModel& model, const PoseParams& pose, DepthInput& input) {
+  const auto& cam = input.camera;
+  const PosedHand hand(model, pose);
+  std::vector<float> depth(static_cast<size_t>(cam.width * cam.height), 0.0F);
+  std::vector<uint8_t> mask(depth.size(), 0);
+  double farthest = 0.0;
+  for (int p = 0; p < hand.gaussian_count(); ++p) {
+    const Eigen::Vector3d& c = hand.centre(p);
+    const double sigma = model.gaussians()[static_cast<size_t>(p)].sigma_mm;
+    const auto uv = cam.project(c);
+    const double r = sigma * cam.focal() / c.z();
+    farthest = std::max(farthest, c.z());
+    for (int v = std::max(0, static_cast<int>(uv.y() - r)); v <= std::min(cam.height - 1, static_cast<int>(uv.y() + r)); ++v) {
+      for (int u = std::max(0, static_cast<int>(uv.x() - r)); u <= std::min(cam.width - 1, static_cast<int>(uv.x() + r));
+           ++u) {
+        if (std::hypot(u - uv.x(), v - uv.y()) > r) continue;
+        const size_t i = static_cast<size_t>(v) * cam.width + u;
+        const auto d = static_cast<float>(c.z() - sigma);
+        if (mask[i] == 0 || d < depth[i]) depth[i] = d;
+        mask[i] = 1;
+      }
+    }
+  }
+  for (size_t i = 0; i < depth.size(); ++i) {
+    if (mask[i] == 0) depth[i] = static_cast<float>(farthest + 200.0);
+  }
+  input.free_space.build(cam, depth, mask);
+}
+
 // The other hand for E_hand: the same model at `other` (its own angles and rotation), moved so that
 // its wrist is `offset_mm` from this hand's. Mirrored, it is a left hand (the right-hand model at
 // x-negated translation, then every centre's x negated): the two hands' thumbs then face each other.
@@ -122,6 +154,29 @@ TEST_P(EnergyGradient, EveryTermMatchesFiniteDifferences) {
   const EnergyFrame frame{&model, &input, &prev, &prev2};
   expect_gradient_matches([&](const PoseParams& p, PoseGradient* g) { return total.evaluate(frame, p, hand, g); },
                           pose, "E (eq. 2)");
+
+  // E_free against the silhouette of a pose 12-15 mm away with other finger angles: some of the
+  // model's Gaussians over the wall behind.
+  DepthInput seen = input;
+  PoseParams seen_pose = random_pose(rng);
+  seen_pose.head<3>() = pose.head<3>() + Eigen::Vector3d(12, -9, 6);
+  add_silhouette(model, seen_pose, seen);
+  const FreeSpaceTerm free_space;
+  hand.update(model, pose);
+  EXPECT_GT(free_space.evaluate(hand, seen, nullptr), 1e-3) << "parts of the model must be over free space";
+  expect_gradient_matches(
+      [&](const PoseParams& p, PoseGradient* g) {
+        hand.update(model, p);
+        return free_space.evaluate(hand, seen, g);
+      },
+      pose, "E_free");
+  EnergyWeights with_free;
+  with_free.free_space = 2.0;
+  const PoseEnergy total_free(SimilarityFactor::kDepth, with_free);
+  const EnergyFrame seen_frame{&model, &seen, &prev, &prev2};
+  expect_gradient_matches(
+      [&](const PoseParams& p, PoseGradient* g) { return total_free.evaluate(seen_frame, p, hand, g); }, pose,
+      "E with E_free");
 
   // E_hand against another hand overlapping this one: beside it (a second right hand), and a left
   // hand (mirrored) reaching into it from the thumb side; its pose is one more random pose.

@@ -4,6 +4,7 @@
 // leaves become unit-weight 2D Gaussians.
 
 #include "handtrack/core/camera.hpp"
+#include "handtrack/core/free_space.hpp"
 #include "handtrack/core/image_mixture.hpp"
 
 #include <Eigen/Core>
@@ -26,6 +27,7 @@ struct DepthInputConfig {
   double continuity_mm = 25.0;          // neighbouring pixels closer than this are one surface
   double min_hand_area_mm2 = 1500.0;    // smaller blobs are noise, not a hand
   double hand_length_mm = 190.0;        // wrist to middle fingertip, bounds the hand region
+  FreeSpaceConfig free_space;           // where no part of the hand can be (E_free; ours)
 };
 
 // What the tracker knows about where the hand was: lets segmentation keep the hand and cut the
@@ -54,6 +56,7 @@ struct DepthInput {
   std::vector<uint8_t> pixel_labels;  // part label per pixel (0 = none); empty without a labeller
   std::vector<ImageGaussian> gaussians;
   ImageMixture mixture;               // `gaussians` laid out for E_sim; assign(gaussians) after changing them
+  FreeSpaceMap free_space;            // distance to where the hand can be, around the hand (E_free)
   double self_similarity = 0.0;       // E(C_I, C_I), normalises E_sim (Sec. 4.1)
   int hand_pixels = 0;
   Eigen::Vector3d hand_centroid_mm = Eigen::Vector3d::Zero();  // mean 3D point of the hand pixels

@@ -3,8 +3,9 @@
 //
 //   E(Theta) = E_sim - w_c E_col - w_l E_lim - w_s E_smo                    (paper eq. 2)
 //
-// and, where another hand is tracked at the same time (issue 14; ours, the paper has one hand),
-// - w_h E_hand, the same Gaussian overlap as E_col between this hand and the other (fixed) one.
+// minus w_f E_free (ours): model parts over the background, which E_sim does not see; and, where
+// another hand is tracked at the same time (issue 14; ours, the paper has one hand), minus w_h
+// E_hand, the same Gaussian overlap as E_col between this hand and the other (fixed) one.
 //
 // One class per term; each returns its value and adds its analytic gradient (d term / d Theta)
 // into a PoseGradient when asked. The detection-guided energy of Sec. 4.3 is the same energy with
@@ -26,6 +27,10 @@ struct EnergyWeights {
   // w_h of E_hand: ours (issue 14), the paper tracks one hand. 1.0 weighs an overlap with the other
   // hand as much as the same overlap between two fingers of this hand (w_c).
   double inter_hand = 1.0;
+  // w_f of E_free: ours, the paper has no term for model parts over the background. Measured over
+  // 0 / 1 / 2 / 3 / 5 / 10 on the broadened benchmark (docs/TRACKER.md, "Free space"): 1 was best
+  // over six seeds; 0 is the paper's energy. PoseTracker uses it with late fusion only.
+  double free_space = 1.0;
   // R_i, Sec. 4.3: radius of influence of the label similarity factor.
   double label_radius_mm = 200.0;
   // E_smo mixes units; the paper's w_s = 1 balances it in SI units (metres and radians), so
@@ -135,6 +140,24 @@ class InterHandCollisionTerm {
                           CentreGradients* dE_dcentres) const;
 };
 
+// E_free = 1/|C_h| * sum_p (max(0, r_p - s) / l)^2                                      (ours)
+// r_p = D(u_p, v_p) z_p / f: how deep (mm at the Gaussian's depth) the projected centre of model
+// Gaussian p lies in free space, where the camera sees through to the background or sees nothing
+// (FreeSpaceMap: D in px); slack s = 5 mm for ragged edges, scale l = 10 mm. The centres of a hand's
+// Gaussians lie inside its silhouette, so a pose that fits pays nothing; a finger the camera cannot
+// see, left stretched out over the background, pays for each of its Gaussians. With e_p = max(0,
+// r_p - s) and the projection u = fx x/z + cx, v = fy y/z + cy:
+//   dE/dr_p = 2 e_p / (|C_h| l^2)
+//   dr_p/dx = z/f dD/du fx/z,  dr_p/dy = z/f dD/dv fy/z,
+//   dr_p/dz = D/f - z/f (dD/du fx x + dD/dv fy y) / z^2
+// (D bilinear between pixel centres, so its gradient is exact between them).
+class FreeSpaceTerm {
+ public:
+  double evaluate(const PosedHand& hand, const DepthInput& input, PoseGradient* gradient) const;
+  // E_free, adding dE_free/d centre of each model Gaussian into *dE_dcentres when not null.
+  double evaluate_centres(const PosedHand& hand, const DepthInput& input, CentreGradients* dE_dcentres) const;
+};
+
 // E_lim = sum_j (theta_j^l - theta_j)^2 below the limit, (theta_j - theta_j^h)^2 above   (eq. 9)
 class JointLimitTerm {
  public:
@@ -160,6 +183,7 @@ struct EnergyBreakdown {
   double limits = 0.0;
   double smoothness = 0.0;
   double inter_hand = 0.0;  // E_hand; 0 without EnergyFrame::other_hand
+  double free_space = 0.0;  // E_free; 0 while w_f = 0
   double total = 0.0;
 };
 
@@ -177,7 +201,7 @@ class PoseEnergy {
   // `label_share`: s of SimilarityFactor::kDepthAndLabel (unused by the other factors).
   PoseEnergy(SimilarityFactor factor, const EnergyWeights& weights, double label_share = 0.5);
 
-  // E(Theta) (eq. 2; minus w_h E_hand when frame.other_hand is set); adds dE/dTheta into *gradient
+  // E(Theta) (eq. 2; minus w_f E_free, and minus w_h E_hand when frame.other_hand is set); adds dE/dTheta into *gradient
   // (which it zeroes first) when not null.
   // `hand` is scratch space for the posed model.
   double evaluate(const EnergyFrame& frame, const PoseParams& params, PosedHand& hand, PoseGradient* gradient,
@@ -193,6 +217,7 @@ class PoseEnergy {
   double label_share_;
   CollisionTerm collision_;
   InterHandCollisionTerm inter_hand_;
+  FreeSpaceTerm free_space_;
   JointLimitTerm limits_;
   SmoothnessTerm smoothness_;
 };

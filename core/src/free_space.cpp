@@ -1,0 +1,160 @@
+#include "handtrack/core/free_space.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace handtrack {
+
+namespace {
+
+constexpr float kFar = std::numeric_limits<float>::infinity();
+
+// The exact squared Euclidean distance transform along one line (Felzenszwalb and Huttenlocher,
+// "Distance Transforms of Sampled Functions", 2012): out[i] = min_j (i - j)^2 + f[j], the lower
+// envelope of the parabolas rooted at each j with f[j] finite. `site` and `bound` are scratch of
+// n and n + 1 entries.
+void squared_distance_1d(const float* f, int n, int stride, float* out, int* site, float* bound) {
+  int k = -1;
+  for (int q = 0; q < n; ++q) {
+    const float fq = f[static_cast<ptrdiff_t>(q) * stride];
+    if (fq == kFar) continue;
+    float s = -kFar;
+    while (k >= 0) {
+      const int p = site[k];
+      const float fp = f[static_cast<ptrdiff_t>(p) * stride];
+      // Where the parabolas of p and q meet.
+      s = ((fq + static_cast<float>(q) * q) - (fp + static_cast<float>(p) * p)) / (2.0F * static_cast<float>(q - p));
+      if (s > bound[k]) break;
+      --k;
+    }
+    ++k;
+    site[k] = q;
+    bound[k] = k == 0 ? -kFar : s;
+    bound[k + 1] = kFar;
+  }
+  for (int q = 0, j = 0; q < n; ++q) {
+    float& o = out[static_cast<ptrdiff_t>(q) * stride];
+    if (k < 0) {
+      o = kFar;
+      continue;
+    }
+    while (bound[j + 1] < static_cast<float>(q)) ++j;
+    const auto d = static_cast<float>(q - site[j]);
+    o = d * d + f[static_cast<ptrdiff_t>(site[j]) * stride];
+  }
+}
+
+}  // namespace
+
+void FreeSpaceMap::clear() {
+  distance_px_.clear();
+  width_ = height_ = 0;
+  cap_px_ = 0.0;
+}
+
+void FreeSpaceMap::build(const CameraIntrinsics& camera, const std::vector<float>& depth_mm,
+                         const std::vector<uint8_t>& hand_mask, const FreeSpaceConfig& config) {
+  const int w = camera.width;
+  const int h = camera.height;
+  const auto pixels = static_cast<size_t>(w) * static_cast<size_t>(h);
+  clear();
+  if (w <= 0 || h <= 0 || depth_mm.size() != pixels || hand_mask.size() != pixels) return;
+  // The hand's box and depth range.
+  int u_lo = w;
+  int v_lo = h;
+  int u_hi = -1;
+  int v_hi = -1;
+  float near_mm = kFar;
+  float far_mm = 0.0F;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const size_t i = static_cast<size_t>(v) * w + u;
+      const float d = depth_mm[i];
+      if (hand_mask[i] == 0 || !(d > 0.0F)) continue;
+      u_lo = std::min(u_lo, u);
+      u_hi = std::max(u_hi, u);
+      v_lo = std::min(v_lo, v);
+      v_hi = std::max(v_hi, v);
+      near_mm = std::min(near_mm, d);
+      far_mm = std::max(far_mm, d);
+    }
+  }
+  if (u_hi < 0) return;
+  // The cap in pixels where it is largest, at the hand's nearest depth; the box reaches that far
+  // around the hand, and one pixel beyond the image (not free: the hand may go on there).
+  cap_px_ = config.cap_mm * camera.focal() / near_mm;
+  const int reach = static_cast<int>(std::ceil(cap_px_)) + 1;
+  u0_ = std::max(-1, u_lo - reach);
+  v0_ = std::max(-1, v_lo - reach);
+  width_ = std::min(w, u_hi + reach + 1) - u0_ + 1;
+  height_ = std::min(h, v_hi + reach + 1) - v0_ + 1;
+  const size_t box = static_cast<size_t>(width_) * static_cast<size_t>(height_);
+  const size_t room = static_cast<size_t>(w + 2) * static_cast<size_t>(h + 2);
+  if (distance_px_.capacity() < room) distance_px_.reserve(room);
+  if (scratch_.capacity() < room) scratch_.reserve(room);
+  if (site_.capacity() < static_cast<size_t>(std::max(w, h) + 3)) {
+    site_.reserve(static_cast<size_t>(std::max(w, h) + 3));
+    bound_.reserve(static_cast<size_t>(std::max(w, h) + 4));
+  }
+  distance_px_.resize(box);
+  scratch_.resize(box);
+  site_.resize(static_cast<size_t>(std::max(width_, height_)));
+  bound_.resize(static_cast<size_t>(std::max(width_, height_)) + 1);
+  const float free_beyond_mm = far_mm + static_cast<float>(config.margin_mm);
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x) {
+      const int u = u0_ + x;
+      const int v = v0_ + y;
+      bool free_space = false;
+      if (u >= 0 && v >= 0 && u < w && v < h) {
+        const float d = depth_mm[static_cast<size_t>(v) * w + u];
+        free_space = !(d > 0.0F) || d > free_beyond_mm;
+      }
+      scratch_[static_cast<size_t>(y) * width_ + x] = free_space ? kFar : 0.0F;
+    }
+  }
+  // Squared distances along the columns, then along the rows of those (separable: the exact EDT).
+  for (int x = 0; x < width_; ++x) {
+    squared_distance_1d(scratch_.data() + x, height_, width_, distance_px_.data() + x, site_.data(), bound_.data());
+  }
+  for (int y = 0; y < height_; ++y) {
+    float* row = distance_px_.data() + static_cast<ptrdiff_t>(y) * width_;
+    std::copy(row, row + width_, scratch_.data());
+    squared_distance_1d(scratch_.data(), width_, 1, row, site_.data(), bound_.data());
+  }
+  const auto cap = static_cast<float>(cap_px_);
+  for (float& d : distance_px_) d = std::min(cap, std::sqrt(d));
+}
+
+double FreeSpaceMap::at(int u, int v) const {
+  const int x = u - u0_;
+  const int y = v - v0_;
+  if (x < 0 || y < 0 || x >= width_ || y >= height_) return cap_px_;
+  return distance_px_[static_cast<size_t>(y) * width_ + x];
+}
+
+FreeSpaceMap::Sample FreeSpaceMap::sample(double u, double v) const {
+  if (empty() || !std::isfinite(u) || !std::isfinite(v)) return {cap_px_, 0.0, 0.0};
+  // Far outside the box: the cap (and no overflow in the conversion below).
+  const double lo_u = u0_ - 2.0;
+  const double lo_v = v0_ - 2.0;
+  if (u < lo_u || v < lo_v || u > u0_ + width_ + 1.0 || v > v0_ + height_ + 1.0) return {cap_px_, 0.0, 0.0};
+  const double fu = std::floor(u);
+  const double fv = std::floor(v);
+  const double a = u - fu;
+  const double b = v - fv;
+  const int i = static_cast<int>(fu);
+  const int j = static_cast<int>(fv);
+  const double d00 = at(i, j);
+  const double d10 = at(i + 1, j);
+  const double d01 = at(i, j + 1);
+  const double d11 = at(i + 1, j + 1);
+  Sample s;
+  s.distance_px = (1 - a) * (1 - b) * d00 + a * (1 - b) * d10 + (1 - a) * b * d01 + a * b * d11;
+  s.d_du = (1 - b) * (d10 - d00) + b * (d11 - d01);
+  s.d_dv = (1 - a) * (d01 - d00) + a * (d11 - d10);
+  return s;
+}
+
+}  // namespace handtrack

@@ -1,0 +1,134 @@
+// FreeSpaceMap (E_free's distances): exact Euclidean distances to the nearest pixel where the hand
+// can be, what counts as free space, the image's edge, the cap, and the bilinear sample.
+#include "handtrack/core/free_space.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace handtrack {
+namespace {
+
+constexpr float kHandMm = 400.0F;
+
+// A 320x240 scene: a wall at 700 mm (free: far behind the hand), a 30x40 px hand at 400 mm.
+struct Scene {
+  CameraIntrinsics camera;
+  std::vector<float> depth;
+  std::vector<uint8_t> mask;
+  Scene() : depth(static_cast<size_t>(camera.width * camera.height), 700.0F), mask(depth.size(), 0) {}
+  void fill(int u0, int v0, int u1, int v1, float mm, bool hand) {
+    for (int v = v0; v < v1; ++v) {
+      for (int u = u0; u < u1; ++u) {
+        const size_t i = static_cast<size_t>(v) * camera.width + u;
+        depth[i] = mm;
+        mask[i] = hand ? 1 : 0;
+      }
+    }
+  }
+  [[nodiscard]] bool free_at(int u, int v, float margin_mm) const {
+    if (u < 0 || v < 0 || u >= camera.width || v >= camera.height) return false;
+    const float d = depth[static_cast<size_t>(v) * camera.width + u];
+    return d <= 0.0F || d > kHandMm + margin_mm;
+  }
+  // Brute force: the distance from (u, v) to the nearest pixel that is not free, within `window`
+  // pixels, capped.
+  [[nodiscard]] double brute_distance(int u, int v, double cap, float margin_mm) const {
+    double best = std::numeric_limits<double>::infinity();
+    const int window = static_cast<int>(cap) + 2;
+    for (int y = v - window; y <= v + window; ++y) {
+      for (int x = u - window; x <= u + window; ++x) {
+        if (!free_at(x, y, margin_mm)) best = std::min(best, std::hypot(x - u, y - v));
+      }
+    }
+    return std::min(best, cap);
+  }
+};
+
+TEST(FreeSpaceMap, DistanceIsEuclideanToTheNearestPixelWhereTheHandCanBe) {
+  Scene scene;
+  scene.fill(100, 100, 130, 140, kHandMm, true);
+  scene.fill(150, 100, 160, 110, 300.0F, false);  // an occluder nearer than the hand: not free
+  scene.fill(100, 150, 140, 160, 0.0F, false);    // no depth: free
+  scene.fill(60, 100, 70, 140, 420.0F, false);    // the forearm, at the hand's depth: not free
+  const FreeSpaceConfig config;
+  FreeSpaceMap map;
+  map.build(scene.camera, scene.depth, scene.mask, config);
+  ASSERT_FALSE(map.empty());
+  const double cap = config.cap_mm * scene.camera.focal() / kHandMm;
+  EXPECT_NEAR(map.cap_px(), cap, 1e-9);
+  const auto margin = static_cast<float>(config.margin_mm);
+  int checked_inside_cap = 0;
+  // Within the cap of the hand (the map's box); beyond it, the cap.
+  const int reach = static_cast<int>(cap);
+  for (int v = 100 - reach; v < 140 + reach; v += 3) {
+    for (int u = 100 - reach; u < 130 + reach; u += 3) {
+      const double expected = scene.brute_distance(u, v, cap, margin);
+      ASSERT_NEAR(map.at(u, v), expected, 1e-4) << "pixel " << u << "," << v;
+      if (expected > 0.0 && expected < cap) ++checked_inside_cap;
+    }
+  }
+  EXPECT_GT(checked_inside_cap, 500);
+  EXPECT_EQ(map.at(115, 120), 0.0) << "the hand";
+  EXPECT_EQ(map.at(155, 105), 0.0) << "an occluder";
+  EXPECT_EQ(map.at(65, 120), 0.0) << "the forearm";
+  EXPECT_NEAR(map.at(120, 155), 16.0, 1e-4) << "no depth is free: 16 px below the hand";
+  EXPECT_EQ(map.at(5, 5), cap) << "outside the map's box";
+}
+
+TEST(FreeSpaceMap, ASurfaceJustBehindTheHandIsNotFreeAndTheImageEdgeIsNot) {
+  Scene scene;
+  scene.fill(0, 0, scene.camera.width, scene.camera.height, 600.0F, false);
+  scene.fill(10, 100, 40, 140, kHandMm, true);
+  scene.fill(40, 100, 60, 140, kHandMm + 20.0F, false);  // a table 20 mm behind: within the margin
+  FreeSpaceMap map;
+  map.build(scene.camera, scene.depth, scene.mask);
+  EXPECT_EQ(map.at(55, 120), 0.0) << "a table the hand rests on";
+  EXPECT_NEAR(map.at(65, 120), 6.0, 1e-4);
+  EXPECT_NEAR(map.at(0, 90), 1.0, 1e-4) << "the pixel beyond the image's edge is not free";
+  EXPECT_NEAR(map.at(5, 90), 6.0, 1e-4);
+}
+
+TEST(FreeSpaceMap, SampleIsBilinearWithItsGradient) {
+  Scene scene;
+  scene.fill(100, 100, 130, 140, kHandMm, true);
+  FreeSpaceMap map;
+  map.build(scene.camera, scene.depth, scene.mask);
+  for (const auto& [u, v] : {std::pair{133.3, 95.6}, std::pair{97.2, 120.9}, std::pair{140.45, 150.1}}) {
+    const FreeSpaceMap::Sample s = map.sample(u, v);
+    const int i = static_cast<int>(std::floor(u));
+    const int j = static_cast<int>(std::floor(v));
+    const double a = u - i;
+    const double b = v - j;
+    const double expected = (1 - a) * (1 - b) * map.at(i, j) + a * (1 - b) * map.at(i + 1, j) +
+                            (1 - a) * b * map.at(i, j + 1) + a * b * map.at(i + 1, j + 1);
+    EXPECT_NEAR(s.distance_px, expected, 1e-12);
+    constexpr double h = 1e-6;
+    EXPECT_NEAR(s.d_du, (map.sample(u + h, v).distance_px - map.sample(u - h, v).distance_px) / (2 * h), 1e-6);
+    EXPECT_NEAR(s.d_dv, (map.sample(u, v + h).distance_px - map.sample(u, v - h).distance_px) / (2 * h), 1e-6);
+    EXPECT_GT(std::hypot(s.d_du, s.d_dv), 0.5) << "outside the hand the distance grows";
+  }
+  const FreeSpaceMap::Sample far = map.sample(1e12, -1e12);
+  EXPECT_EQ(far.distance_px, map.cap_px());
+  EXPECT_EQ(far.d_du, 0.0);
+  const FreeSpaceMap::Sample nan = map.sample(std::nan(""), 3.0);
+  EXPECT_EQ(nan.distance_px, map.cap_px());
+}
+
+TEST(FreeSpaceMap, EmptyWithoutAHandOrWithMismatchedSizes) {
+  Scene scene;
+  FreeSpaceMap map;
+  map.build(scene.camera, scene.depth, scene.mask);
+  EXPECT_TRUE(map.empty());
+  scene.fill(100, 100, 130, 140, kHandMm, true);
+  std::vector<uint8_t> short_mask(10, 1);
+  map.build(scene.camera, scene.depth, short_mask);
+  EXPECT_TRUE(map.empty());
+  EXPECT_EQ(map.sample(120, 120).distance_px, 0.0) << "an empty map charges nothing";
+}
+
+}  // namespace
+}  // namespace handtrack
