@@ -66,7 +66,9 @@ std::string case_name(const ::testing::TestParamInfo<ViewCase>& info) {
 
 // Measured at seed 21 when this test was written: palm 5.6 (right) and 4.2 mm (left), back 19.0 mm
 // with 74 % of the frames reported as the right hand, side 4.6, fingers-toward 9.0, fingers-away
-// 15.6 (left), head-mounted 39.6 mm; every other view 100 % the hand shown.
+// 15.6 (left), head-mounted 39.6 mm; every other view 100 % the hand shown. With the free-space
+// term E_free: palm 5.5 / 4.8, back 16.1 (74 %), side 6.9, fingers-toward 8.5, fingers-away 14.2,
+// head-mounted 28.2 mm (its bound lowered from 55 to 40 mm).
 INSTANTIATE_TEST_SUITE_P(
     ShippedConfiguration, EveryView,
     ::testing::Values(ViewCase{synth::View::kPalm, synth::Handedness::kRight, 12.0, 0.98},
@@ -75,7 +77,7 @@ INSTANTIATE_TEST_SUITE_P(
                       ViewCase{synth::View::kSide, synth::Handedness::kRight, 15.0, 0.98},
                       ViewCase{synth::View::kFingersToward, synth::Handedness::kRight, 20.0, 0.98},
                       ViewCase{synth::View::kFingersAway, synth::Handedness::kLeft, 25.0, 0.98},
-                      ViewCase{synth::View::kHeadMounted, synth::Handedness::kRight, 55.0, 0.98}),
+                      ViewCase{synth::View::kHeadMounted, synth::Handedness::kRight, 40.0, 0.98}),
     case_name);
 
 }  // namespace
