@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace handtrack {
@@ -14,17 +15,16 @@ constexpr float kFar = std::numeric_limits<float>::infinity();
 // "Distance Transforms of Sampled Functions", 2012): out[i] = min_j (i - j)^2 + f[j], the lower
 // envelope of the parabolas rooted at each j with f[j] finite. `site` and `bound` are scratch of
 // n and n + 1 entries.
-void squared_distance_1d(const float* f, int n, int stride, float* out, int* site, float* bound) {
+void squared_distance_1d(const float* f, int n, float* out, int* site, float* bound) {
   int k = -1;
   for (int q = 0; q < n; ++q) {
-    const float fq = f[static_cast<ptrdiff_t>(q) * stride];
+    const float fq = f[q];
     if (fq == kFar) continue;
     float s = -kFar;
     while (k >= 0) {
       const int p = site[k];
-      const float fp = f[static_cast<ptrdiff_t>(p) * stride];
       // Where the parabolas of p and q meet.
-      s = ((fq + static_cast<float>(q) * q) - (fp + static_cast<float>(p) * p)) / (2.0F * static_cast<float>(q - p));
+      s = ((fq + static_cast<float>(q) * q) - (f[p] + static_cast<float>(p) * p)) / (2.0F * static_cast<float>(q - p));
       if (s > bound[k]) break;
       --k;
     }
@@ -34,14 +34,13 @@ void squared_distance_1d(const float* f, int n, int stride, float* out, int* sit
     bound[k + 1] = kFar;
   }
   for (int q = 0, j = 0; q < n; ++q) {
-    float& o = out[static_cast<ptrdiff_t>(q) * stride];
     if (k < 0) {
-      o = kFar;
+      out[q] = kFar;
       continue;
     }
     while (bound[j + 1] < static_cast<float>(q)) ++j;
     const auto d = static_cast<float>(q - site[j]);
-    o = d * d + f[static_cast<ptrdiff_t>(site[j]) * stride];
+    out[q] = d * d + f[site[j]];
   }
 }
 
@@ -59,7 +58,7 @@ void FreeSpaceMap::build(const CameraIntrinsics& camera, const std::vector<float
   const int h = camera.height;
   const auto pixels = static_cast<size_t>(w) * static_cast<size_t>(h);
   clear();
-  if (w <= 0 || h <= 0 || depth_mm.size() != pixels || hand_mask.size() != pixels) return;
+  if (!config.enabled || w <= 0 || h <= 0 || depth_mm.size() != pixels || hand_mask.size() != pixels) return;
   // The hand's box and depth range.
   int u_lo = w;
   int v_lo = h;
@@ -68,16 +67,19 @@ void FreeSpaceMap::build(const CameraIntrinsics& camera, const std::vector<float
   float near_mm = kFar;
   float far_mm = 0.0F;
   for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      const size_t i = static_cast<size_t>(v) * w + u;
-      const float d = depth_mm[i];
-      if (hand_mask[i] == 0 || !(d > 0.0F)) continue;
+    const uint8_t* mask = hand_mask.data() + static_cast<size_t>(v) * w;
+    const float* depth = depth_mm.data() + static_cast<size_t>(v) * w;
+    // Most rows hold no hand: find its first pixel (memchr-fast) before looking at depths.
+    const auto* first = static_cast<const uint8_t*>(std::memchr(mask, 1, static_cast<size_t>(w)));
+    if (first == nullptr) continue;
+    for (int u = static_cast<int>(first - mask); u < w; ++u) {
+      if (mask[u] == 0 || !(depth[u] > 0.0F)) continue;
       u_lo = std::min(u_lo, u);
       u_hi = std::max(u_hi, u);
       v_lo = std::min(v_lo, v);
       v_hi = std::max(v_hi, v);
-      near_mm = std::min(near_mm, d);
-      far_mm = std::max(far_mm, d);
+      near_mm = std::min(near_mm, depth[u]);
+      far_mm = std::max(far_mm, depth[u]);
     }
   }
   if (u_hi < 0) return;
@@ -102,26 +104,40 @@ void FreeSpaceMap::build(const CameraIntrinsics& camera, const std::vector<float
   site_.resize(static_cast<size_t>(std::max(width_, height_)));
   bound_.resize(static_cast<size_t>(std::max(width_, height_)) + 1);
   const float free_beyond_mm = far_mm + static_cast<float>(config.margin_mm);
+  // The box's columns inside the image; the ring beyond it is not free.
+  const int x_in_begin = -u0_ > 0 ? -u0_ : 0;
+  const int x_in_end = std::min(width_, w - u0_);
   for (int y = 0; y < height_; ++y) {
-    for (int x = 0; x < width_; ++x) {
-      const int u = u0_ + x;
-      const int v = v0_ + y;
-      bool free_space = false;
-      if (u >= 0 && v >= 0 && u < w && v < h) {
-        const float d = depth_mm[static_cast<size_t>(v) * w + u];
-        free_space = !(d > 0.0F) || d > free_beyond_mm;
-      }
-      scratch_[static_cast<size_t>(y) * width_ + x] = free_space ? kFar : 0.0F;
+    float* out = scratch_.data() + static_cast<size_t>(y) * width_;
+    std::fill(out, out + width_, 0.0F);
+    const int v = v0_ + y;
+    if (v < 0 || v >= h) continue;
+    const float* depth = depth_mm.data() + static_cast<size_t>(v) * w;
+    for (int x = x_in_begin; x < x_in_end; ++x) {
+      const float d = depth[u0_ + x];
+      out[x] = (d <= 0.0F || d > free_beyond_mm) ? kFar : 0.0F;
     }
   }
   // Squared distances along the columns, then along the rows of those (separable: the exact EDT).
-  for (int x = 0; x < width_; ++x) {
-    squared_distance_1d(scratch_.data() + x, height_, width_, distance_px_.data() + x, site_.data(), bound_.data());
+  // Along a column the input is binary (0 or infinity): the distance to the nearest pixel that is
+  // not free is one sweep down and one up, a whole row at a time (vectorised).
+  const auto w_box = static_cast<size_t>(width_);
+  for (int y = 0; y < height_; ++y) {
+    const float* in = scratch_.data() + y * w_box;
+    float* out = distance_px_.data() + y * w_box;
+    const float* above = y > 0 ? out - w_box : nullptr;
+    for (size_t x = 0; x < w_box; ++x) out[x] = in[x] == 0.0F ? 0.0F : (above != nullptr ? above[x] + 1.0F : kFar);
   }
+  for (int y = height_ - 2; y >= 0; --y) {
+    float* out = distance_px_.data() + static_cast<size_t>(y) * w_box;
+    const float* below = out + w_box;
+    for (size_t x = 0; x < w_box; ++x) out[x] = std::min(out[x], below[x] + 1.0F);
+  }
+  for (float& d : distance_px_) d *= d;
   for (int y = 0; y < height_; ++y) {
     float* row = distance_px_.data() + static_cast<ptrdiff_t>(y) * width_;
     std::copy(row, row + width_, scratch_.data());
-    squared_distance_1d(scratch_.data(), width_, 1, row, site_.data(), bound_.data());
+    squared_distance_1d(scratch_.data(), width_, row, site_.data(), bound_.data());
   }
   const auto cap = static_cast<float>(cap_px_);
   for (float& d : distance_px_) d = std::min(cap, std::sqrt(d));

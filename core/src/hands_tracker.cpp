@@ -51,7 +51,7 @@ void HandsInputs::build_slot(int slot, const DepthImage& depth, const HandsReque
 }
 
 HandsTracker::HandsTracker(const TrackerConfig& config)
-    : config_(config), max_hands_(std::clamp(config.max_hands, 1, kMaxHands)), inputs_(config.input) {
+    : config_(config), max_hands_(std::clamp(config.max_hands, 1, kMaxHands)), inputs_(input_config(config)) {
   for (size_t s = 0; s < slots_.size(); ++s) {
     TrackerConfig c = config;
     c.seed = config.seed + s;  // each hand its own particles

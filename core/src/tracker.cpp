@@ -152,7 +152,7 @@ void TrackerInputs::build(const DepthImage& depth, const InputRequest& request, 
 }
 
 Tracker::Tracker(const TrackerConfig& config)
-    : right_(config), left_(config), inputs_(config.input),
+    : right_(config), left_(config), inputs_(input_config(config)),
       current_(config.handedness == HandednessMode::kLeft ? Handedness::kLeft : Handedness::kRight) {}
 
 void Tracker::resume(const TrackerOutput& last) {
@@ -278,6 +278,12 @@ EnergyWeights mode_weights(const TrackerConfig& config) {
   return weights;
 }
 }  // namespace
+
+DepthInputConfig input_config(const TrackerConfig& config) {
+  DepthInputConfig input = config.input;
+  input.free_space.enabled = mode_weights(config).free_space != 0.0;
+  return input;
+}
 
 PoseTracker::PoseTracker(TrackerConfig config)
     : config_(config),

@@ -128,6 +128,10 @@ TEST(FreeSpaceMap, EmptyWithoutAHandOrWithMismatchedSizes) {
   map.build(scene.camera, scene.depth, short_mask);
   EXPECT_TRUE(map.empty());
   EXPECT_EQ(map.sample(120, 120).distance_px, 0.0) << "an empty map charges nothing";
+  FreeSpaceConfig off;
+  off.enabled = false;
+  map.build(scene.camera, scene.depth, scene.mask, off);
+  EXPECT_TRUE(map.empty()) << "disabled (no energy reads it)";
 }
 
 }  // namespace

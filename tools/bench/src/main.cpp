@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
       tc.max_hands = bc.max_hands;
       tc.check_iterations_per_frame = bc.check_iterations_per_frame;
       // The shipped tracker (handedness auto), its two steps timed apart.
-      HandsInputs inputs(tc.input);
+      HandsInputs inputs(input_config(tc));
       HandsTracker tracker(tc);
       std::optional<SideThread> side;
       if (bc.side_thread) side.emplace();

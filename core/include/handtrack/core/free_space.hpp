@@ -24,6 +24,7 @@ namespace handtrack {
 struct FreeSpaceConfig {
   double margin_mm = 30.0;  // free = farther than the hand's farthest pixel by this much, or no depth
   double cap_mm = 60.0;     // distances are capped here (and the map's box reaches this far)
+  bool enabled = true;      // false: build() leaves the map empty (no tracker energy reads it)
 };
 
 class FreeSpaceMap {
@@ -37,7 +38,7 @@ class FreeSpaceMap {
   };
 
   // Builds the map from the full-image depth (mm, 0 = none) and the hand's mask (1 = hand pixel);
-  // empty without hand pixels. Storage is reused: no allocation after the first frame of a size.
+  // empty without hand pixels, or when not config.enabled. Storage is reused: no allocation after the first frame of a size.
   void build(const CameraIntrinsics& camera, const std::vector<float>& depth_mm, const std::vector<uint8_t>& hand_mask,
              const FreeSpaceConfig& config = {});
   void clear();

@@ -109,6 +109,11 @@ struct TrackerConfig {
   uint64_t seed = 1;
 };
 
+// The preprocessing a tracker with `config` needs: config.input, with the free-space map only where
+// an energy reads it (late fusion with w_f > 0: PoseTracker). Every TrackerInputs and HandsInputs
+// made for a tracker is made with this.
+DepthInputConfig input_config(const TrackerConfig& config);
+
 // N points at the origin (Eigen leaves a default-constructed vector uninitialised).
 template <size_t N>
 std::array<Eigen::Vector3d, N> zero_points() {
