@@ -365,9 +365,8 @@ double FreeSpaceTerm::evaluate_centres(const PosedHand& hand, const DepthInput& 
     const Vector3d& mu = hand.centre(i);
     const double z = mu.z();
     if (z < 1.0) continue;  // behind or at the camera: no projection
-    const double u = cam.fx * mu.x() / z + cam.cx;
-    const double v = cam.fy * mu.y() / z + cam.cy;
-    const FreeSpaceMap::Sample d = map.sample(u, v);
+    const Eigen::Vector2d uv = cam.project(mu);
+    const FreeSpaceMap::Sample d = map.sample(uv.x(), uv.y());
     const double excess = d.distance_px * z / f - kFreeSpaceSlackMm;
     if (excess <= 0.0) continue;
     energy += excess * excess;

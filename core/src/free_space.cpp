@@ -95,14 +95,15 @@ void FreeSpaceMap::build(const CameraIntrinsics& camera, const std::vector<float
   const size_t room = static_cast<size_t>(w + 2) * static_cast<size_t>(h + 2);
   if (distance_px_.capacity() < room) distance_px_.reserve(room);
   if (scratch_.capacity() < room) scratch_.reserve(room);
-  if (site_.capacity() < static_cast<size_t>(std::max(w, h) + 3)) {
-    site_.reserve(static_cast<size_t>(std::max(w, h) + 3));
-    bound_.reserve(static_cast<size_t>(std::max(w, h) + 4));
+  // The row transform's scratch: at most one entry per box column (w + 2), and one more bound.
+  if (site_.capacity() < static_cast<size_t>(w + 2)) {
+    site_.reserve(static_cast<size_t>(w + 2));
+    bound_.reserve(static_cast<size_t>(w + 3));
   }
   distance_px_.resize(box);
   scratch_.resize(box);
-  site_.resize(static_cast<size_t>(std::max(width_, height_)));
-  bound_.resize(static_cast<size_t>(std::max(width_, height_)) + 1);
+  site_.resize(static_cast<size_t>(width_));
+  bound_.resize(static_cast<size_t>(width_) + 1);
   const float free_beyond_mm = far_mm + static_cast<float>(config.margin_mm);
   // The box's columns inside the image; the ring beyond it is not free.
   const int x_in_begin = -u0_ > 0 ? -u0_ : 0;

@@ -12,7 +12,8 @@ static_assert(kMaxHands == 2, "run_slots() shares a frame's work between two han
 PreprocessStage::PreprocessStage(const TrackerConfig& config, TrackerReload& reload, const RequestMailbox& request,
                                  const PartForest* forest, PipelineTally& tally, StageWatch& watch, bool side,
                                  std::function<void()> side_setup)
-    : reload_(reload), request_(request), forest_(forest), tally_(tally), watch_(watch), input_config_(input_config(config)) {
+    : reload_(reload), request_(request), forest_(forest), tally_(tally), watch_(watch),
+      input_config_(input_config(config)) {
   build_side_ = [this] { side_frame_->inputs.build_slot(1, side_frame_->depth, side_request_, forest_); };
   if (side) side_ = std::make_unique<SideThread>(std::move(side_setup));
 }

@@ -61,9 +61,10 @@ void add_silhouette(const HandModel& model, const PoseParams& pose, DepthInput& 
     const auto uv = cam.project(c);
     const double r = sigma * cam.focal() / c.z();
     farthest = std::max(farthest, c.z());
-    for (int v = std::max(0, static_cast<int>(uv.y() - r)); v <= std::min(cam.height - 1, static_cast<int>(uv.y() + r)); ++v) {
-      for (int u = std::max(0, static_cast<int>(uv.x() - r)); u <= std::min(cam.width - 1, static_cast<int>(uv.x() + r));
-           ++u) {
+    const int v_end = std::min(cam.height - 1, static_cast<int>(uv.y() + r));
+    const int u_end = std::min(cam.width - 1, static_cast<int>(uv.x() + r));
+    for (int v = std::max(0, static_cast<int>(uv.y() - r)); v <= v_end; ++v) {
+      for (int u = std::max(0, static_cast<int>(uv.x() - r)); u <= u_end; ++u) {
         if (std::hypot(u - uv.x(), v - uv.y()) > r) continue;
         const size_t i = static_cast<size_t>(v) * cam.width + u;
         const auto d = static_cast<float>(c.z() - sigma);

@@ -201,8 +201,8 @@ class PoseEnergy {
   // `label_share`: s of SimilarityFactor::kDepthAndLabel (unused by the other factors).
   PoseEnergy(SimilarityFactor factor, const EnergyWeights& weights, double label_share = 0.5);
 
-  // E(Theta) (eq. 2; minus w_f E_free, and minus w_h E_hand when frame.other_hand is set); adds dE/dTheta into *gradient
-  // (which it zeroes first) when not null.
+  // E(Theta) (eq. 2; minus w_f E_free, and minus w_h E_hand when frame.other_hand is set); adds
+  // dE/dTheta into *gradient (which it zeroes first) when not null.
   // `hand` is scratch space for the posed model.
   double evaluate(const EnergyFrame& frame, const PoseParams& params, PosedHand& hand, PoseGradient* gradient,
                   EnergyBreakdown* breakdown = nullptr) const;

@@ -38,7 +38,8 @@ class FreeSpaceMap {
   };
 
   // Builds the map from the full-image depth (mm, 0 = none) and the hand's mask (1 = hand pixel);
-  // empty without hand pixels, or when not config.enabled. Storage is reused: no allocation after the first frame of a size.
+  // empty without hand pixels, or when not config.enabled. Storage is reused: no allocation after
+  // the first frame of a size.
   void build(const CameraIntrinsics& camera, const std::vector<float>& depth_mm, const std::vector<uint8_t>& hand_mask,
              const FreeSpaceConfig& config = {});
   void clear();
@@ -57,7 +58,7 @@ class FreeSpaceMap {
   double cap_px_ = 0.0;
   std::vector<float> distance_px_;  // row-major over the box
   std::vector<float> scratch_;      // build(): free (infinity) or not (0), then one row at a time
-  std::vector<int> site_;           // build(): the 1D transform's parabola roots
+  std::vector<int> site_;           // build(): the row transform's parabola roots
   std::vector<float> bound_;        // and where each one's reign begins
 };
 
