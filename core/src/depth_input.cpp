@@ -1,12 +1,14 @@
 // DepthInputBuilder: the four steps from a depth image to C_I (paper Sec. 3.1, 4), each in its own
-// unit: median_filter, hand_segmentation, quadtree, image_self_similarity; and the free space around
-// the hand (free_space, ours).
+// unit: median_filter, hand_segmentation, quadtree, image_self_similarity; and, ours, a desk the
+// hand touches taken out before segmentation (support_plane) and the free space around the hand
+// (free_space).
 #include "handtrack/core/depth_input.hpp"
 
 #include "hand_segmentation.hpp"
 #include "image_self_similarity.hpp"
 #include "median_filter.hpp"
 #include "quadtree.hpp"
+#include "support_plane.hpp"
 
 namespace handtrack {
 
@@ -18,6 +20,8 @@ constexpr size_t kReservedLeaves = 2048;
 
 struct DepthInputBuilder::Steps {
   MedianFilter median;
+  SupportPlane support_plane;
+  std::vector<float> without_desk;  // the median-filtered depth without the desk, for the free space
   HandSegmenter segmenter;
   QuadtreeBuilder quadtree;
   SelfSimilarity self_similarity{kReservedLeaves};
@@ -46,8 +50,18 @@ const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::o
     const float m = median[i];
     out_.filtered_mm[i] = (m >= near && m <= far) ? m : 0.0F;
   }
+  // A desk the hand touches: out of the working volume, and free space (the camera sees the desk
+  // there, so no part of the hand is in front of it).
+  const bool desk = steps_->support_plane.find(config_.support_plane, out_.camera, out_.filtered_mm);
+  if (desk) steps_->support_plane.erase(out_.camera, out_.filtered_mm);
   steps_->segmenter.segment(config_, median, hint, out_, foreign);
-  out_.free_space.build(out_.camera, median, out_.hand_mask, config_.free_space);
+  const std::vector<float>* seen = &median;
+  if (desk && config_.free_space.enabled) {
+    steps_->without_desk = median;
+    steps_->support_plane.erase(out_.camera, steps_->without_desk);
+    seen = &steps_->without_desk;
+  }
+  out_.free_space.build(out_.camera, *seen, out_.hand_mask, config_.free_space);
   out_.pixel_labels.clear();
   if (labeller != nullptr && out_.hand_pixels > 0) labeller->label(out_, out_.pixel_labels);
   steps_->quadtree.build(config_, steps_->segmenter.hand_box(), out_);

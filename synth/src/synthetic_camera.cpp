@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <vector>
@@ -37,6 +38,38 @@ PlanePatch make_patch(const Vector3d& origin, const Vector3d& normal, double hal
   return p;
 }
 
+// The desk of Background::kDesk, placed in every frame and moved until it touches the farthest
+// point of what rests on it, then kDeskContactMm further (a contact area, not a point):
+// - palm, back and side views (the forearm across the image): the forearm lies on the desk and the
+//   hand rests on it where it reaches down to it; the desk faces the camera as much as that allows
+//   (its normal is the viewing direction without its component along the forearm);
+// - fingers toward or away from the camera: the desk faces the camera and rises away from it
+//   toward the image top (normal (0, -0.3, -1)) and touches the hand; the forearm, which points
+//   along the viewing direction, would hold the hand far from it, and goes into it instead;
+// - head-mounted: a table under the hand (the table background's normal (0, -1, -0.5)), touched
+//   by the hand; the forearm comes from above it, near the camera.
+constexpr double kDeskContactMm = 3.0;
+
+PlanePatch desk_under(const std::vector<ConeSphere>& primitives, View view) {
+  const bool forearm_on_desk = view == View::kPalm || view == View::kBack || view == View::kSide;
+  Vector3d down = view == View::kHeadMounted ? Vector3d(0.0, 1.0, 0.5) : Vector3d(0.0, 0.3, 1.0);  // into the desk
+  if (forearm_on_desk) {
+    down = Vector3d::UnitZ();
+    for (const auto& p : primitives) {
+      if (p.label != kBackground) continue;  // the forearm
+      const Vector3d along = (p.b - p.a).normalized();
+      down -= down.dot(along) * along;
+    }
+  }
+  down.normalize();
+  double far = -std::numeric_limits<double>::infinity();
+  for (const auto& p : primitives) {
+    if (p.label == kBackground && !forearm_on_desk) continue;
+    far = std::max({far, down.dot(p.a) + p.radius_a, down.dot(p.b) + p.radius_b});
+  }
+  return make_patch(down * (far - kDeskContactMm), -down, 0.0, 0.0);
+}
+
 }  // namespace
 
 std::string_view background_name(Background background) {
@@ -47,12 +80,14 @@ std::string_view background_name(Background background) {
       return "body";
     case Background::kTable:
       return "table";
+    case Background::kDesk:
+      return "desk";
   }
   return "none";
 }
 
 std::optional<Background> parse_background(std::string_view name) {
-  for (auto b : {Background::kNone, Background::kBody, Background::kTable}) {
+  for (auto b : {Background::kNone, Background::kBody, Background::kTable, Background::kDesk}) {
     if (background_name(b) == name) return b;
   }
   return std::nullopt;
@@ -139,6 +174,9 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
     throw std::invalid_argument("motion '" + options.motion +
                                 "' shows a right and a left hand in its own arrangement: no hand or view to choose");
   }
+  if (is_two_hand_motion(options.motion) && options.background == Background::kDesk) {
+    throw std::invalid_argument("motion '" + options.motion + "': the desk background is for one-hand motions");
+  }
   std::array<SubjectScale, kTwoHands> subjects;
   if (options.subject) {
     const auto ok = [](double s) { return std::isfinite(s) && s >= 0.5 && s <= 2.0; };
@@ -172,6 +210,8 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
       planes.push_back(make_patch({30, 250, 780}, {0.15, -0.08, -1.0}, 220.0, 400.0));
       background_solids.push_back(ConeSphere{{30, -150, 790}, {30, -200, 800}, 55.0, 55.0, kBackground});
       background_solids.push_back(ConeSphere{{30, -270, 810}, {30, -270, 810}, 95.0, 95.0, kBackground});
+      break;
+    case Background::kDesk:  // drawn with the hand, in every frame (desk_under)
       break;
     case Background::kTable:
       // A table top through (0, 250, 750) mm rising away from the camera (normal up and toward the
@@ -230,6 +270,7 @@ void SyntheticCamera::render_pose(const HandPose& pose, int frame, SynthFrame& o
   posed_primitives(shape, out.pose, out.joints, s.primitives);
   s.raycaster = s.background;  // same sizes: no allocation
   for (const auto& p : s.primitives) s.raycaster.draw(p);
+  if (s.options.background == Background::kDesk) s.raycaster.draw(desk_under(s.primitives, s.options.view));
   s.develop(frame, out);
   if (s.options.hand == Handedness::kLeft) mirror(out);
   out.hand_count = 1;

@@ -156,6 +156,95 @@ TEST(DepthInput, ASurfaceReachingIntoTheVolumeIsNotAHand) {
   EXPECT_TRUE(fresh.build(blob_scene(cam, 560, false), std::nullopt).has_hand());
 }
 
+// A desk across the whole image rising away toward the top (a plane: 400 mm at the bottom edge,
+// 460 mm in the middle, 540 mm at the top), a hand-sized bump resting on it (up to 25 mm in front of it, its outline on the desk:
+// the depth is continuous from one to the other) and a forearm strip lying on it down to the
+// bottom edge. `in_front_mm` (when not null) gets each pixel's height above the desk.
+DepthImage desk_scene(const CameraIntrinsics& cam, std::vector<float>* in_front_mm = nullptr) {
+  DepthImage img{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 0.0F)};
+  if (in_front_mm != nullptr) in_front_mm->assign(img.depth_mm.size(), 0.0F);
+  const double s = cam.width / 320.0;
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      const double desk = 460.0 / (1.0 + 0.29 * (v - cam.cy) / cam.fy);
+      const double du = (u - cam.cx) / (34.0 * s);
+      const double dv = (v - cam.cy + 10 * s) / (48.0 * s);
+      const double r2 = du * du + dv * dv;
+      double height = 0.0;
+      if (r2 < 1.0) height = 25.0 * (1.0 - r2);
+      if (v > cam.cy + 20 * s && std::abs(u - cam.cx) < 18 * s) height = std::max(height, 15.0);
+      img.at(u, v) = static_cast<float>(desk - height);
+      if (in_front_mm != nullptr) (*in_front_mm)[static_cast<size_t>(v) * cam.width + u] = static_cast<float>(height);
+    }
+  }
+  return img;
+}
+
+TEST(DepthInput, AHandOnADeskIsFoundWithoutTheDesk) {
+  const auto cam = camera(320, 240);
+  std::vector<float> height;
+  const DepthImage img = desk_scene(cam, &height);
+  // Hand and desk are one connected surface: without the plane, the "hand" is no hand or takes in
+  // the desk around it.
+  DepthInputConfig without;
+  without.support_plane.enabled = false;
+  DepthInputBuilder plain(without);
+  const auto& merged = plain.build(img, std::nullopt);
+  int bump = 0;  // pixels of the bump and the forearm clear of the desk's band
+  int desk_taken = 0;
+  for (size_t i = 0; i < height.size(); ++i) {
+    bump += height[i] > 10.0F ? 1 : 0;
+    desk_taken += merged.hand_mask[i] && height[i] < 1.0F ? 1 : 0;
+  }
+  EXPECT_TRUE(!merged.has_hand() || desk_taken > bump / 10) << desk_taken << " desk pixels in the hand";
+
+  DepthInputBuilder builder;
+  const auto& in = builder.build(img, std::nullopt);
+  ASSERT_TRUE(in.has_hand());
+  int kept = 0;
+  int desk_in_hand = 0;  // within SupportPlaneConfig::band_mm of the desk
+  for (size_t i = 0; i < height.size(); ++i) {
+    if (!in.hand_mask[i]) continue;
+    desk_in_hand += height[i] <= 8.0F ? 1 : 0;
+    kept += height[i] > 10.0F ? 1 : 0;
+  }
+  EXPECT_EQ(desk_in_hand, 0);
+  // The hand's pixels clear of the band (the forearm below the wrist is cut, as without a desk).
+  int hand_clear = 0;
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      const auto i = static_cast<size_t>(v) * cam.width + u;
+      hand_clear += height[i] > 10.0F && v < cam.cy + 20 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(kept, 0.9 * hand_clear);
+  // The camera sees the desk beside the hand: free space for E_free, 30 px left of the bump.
+  EXPECT_GT(in.free_space.at(static_cast<int>(cam.cx) - 64, static_cast<int>(cam.cy) - 10), 10.0);
+}
+
+TEST(DepthInput, AFlatHandIsNotADesk) {
+  // A flat plate of 190 cm^2 (more than an open adult hand) facing the camera at 400 mm, with a
+  // forearm to the bottom edge, in front of a body outside the working volume: not removed.
+  const auto cam = camera(320, 240);
+  DepthImage img{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 800.0F)};
+  const double half_u = 0.5 * 110.0 * cam.fx / 400.0;  // 110 x 170 mm
+  const double half_v = 0.5 * 170.0 * cam.fy / 400.0;
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      const bool plate = std::abs(u - cam.cx) < half_u && std::abs(v - cam.cy) < half_v;
+      const bool forearm = v >= cam.cy && std::abs(u - cam.cx) < 0.5 * half_u;
+      if (plate || forearm) img.at(u, v) = 400.0F;
+    }
+  }
+  DepthInputConfig without;
+  without.support_plane.enabled = false;
+  DepthInputBuilder plain(without);
+  DepthInputBuilder builder;
+  const int expected = plain.build(img, std::nullopt).hand_pixels;
+  ASSERT_GT(expected, 0);
+  EXPECT_EQ(builder.build(img, std::nullopt).hand_pixels, expected);
+}
+
 TEST(DepthInput, MedianFilterRemovesFlyingPixels) {
   const auto cam = camera(320, 240);
   DepthImage img = blob_scene(cam, 400, false);

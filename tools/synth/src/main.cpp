@@ -198,7 +198,7 @@ int main(int argc, char** argv) {
                                              "from the seed within +-10%)");
   app.add_flag("--noise,!--no-noise", options.noise, "Sensor noise model on (default) or off");
   app.add_option("--background", background,
-                 "Background: body (default; head-mounted view: table), table or none");
+                 "Background: body (default; head-mounted view: table), table, desk (the hand rests on it) or none");
   app.add_option("--hand", hand, "right (default) or left: the right hand's exact mirror image (not with a "
                                  "two-hand motion: it shows both)");
   app.add_option("--view", view, "Camera arrangement (see --list-views): palm (default), back, side, "
@@ -244,7 +244,7 @@ int main(int argc, char** argv) {
   if (!arrangement) return fail("unknown view '" + view + "' (see --list-views)");
   if (background.empty()) background = *arrangement == handtrack::synth::View::kHeadMounted ? "table" : "body";
   const auto bg = handtrack::synth::parse_background(background);
-  if (!bg) return fail("--background must be body, table or none, got '" + background + "'");
+  if (!bg) return fail("--background must be body, table, desk or none, got '" + background + "'");
   const auto handedness = handtrack::synth::parse_handedness(hand);
   if (!handedness) return fail("--hand must be right or left, got '" + hand + "'");
 

@@ -16,6 +16,17 @@
 
 namespace handtrack {
 
+// A desk, table or wall the hand touches (support_plane.hpp; ours): its pixels leave the working
+// volume before segmentation.
+struct SupportPlaneConfig {
+  bool enabled = true;
+  // More surface than a hand and the visible forearm (~300 cm^2) can be in one plane.
+  double min_area_mm2 = 40000.0;
+  // Pixels within this of the plane, or beyond it, are the plane's: sensor noise (a few mm at arm's
+  // length) and the fingers' lower edges on the desk.
+  double band_mm = 8.0;
+};
+
 struct DepthInputConfig {
   int median_radius_px = 1;             // 3x3 median "to remove flying pixels" (Sec. 4)
   double near_mm = 150.0;               // working volume, Sec. 4: "between 150 mm and 600 mm"
@@ -28,6 +39,7 @@ struct DepthInputConfig {
   double min_hand_area_mm2 = 1500.0;    // smaller blobs are noise, not a hand
   double hand_length_mm = 190.0;        // wrist to middle fingertip, bounds the hand region
   FreeSpaceConfig free_space;           // where no part of the hand can be (E_free; ours)
+  SupportPlaneConfig support_plane;     // a desk the hand rests on is not the hand (ours)
 };
 
 // What the tracker knows about where the hand was: lets segmentation keep the hand and cut the

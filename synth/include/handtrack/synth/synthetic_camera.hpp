@@ -33,6 +33,7 @@ enum class Background {
   kNone,   // only the hand and forearm
   kBody,   // a torso plane 700-850 mm away (and a head), the forearm reaching toward it
   kTable,  // a plane tilted like a table top, below and behind the hand (>= ~600 mm in view)
+  kDesk,   // a desk the forearm lies on and the hand rests on, in every frame (one-hand motions only)
 };
 std::string_view background_name(Background background);
 std::optional<Background> parse_background(std::string_view name);
