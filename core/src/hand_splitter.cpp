@@ -160,6 +160,8 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
   const auto near = static_cast<float>(config.near_mm);
   const auto far = static_cast<float>(config.far_mm);
   for (size_t i = 0; i < n; ++i) volume_[i] = (median[i] >= near && median[i] <= far) ? median[i] : 0.0F;
+  // A desk the hands rest on joins them into one surface with it (support_plane.hpp).
+  if (support_plane_.find(config.support_plane, cam, volume_)) support_plane_.erase(cam, volume_);
   label_surfaces(config, volume_, w, h, component_, stack_, surfaces_);
   claim(config, cam, request);
 

@@ -6,6 +6,7 @@
 // frame to frame.
 #include "hand_segmentation.hpp"
 #include "median_filter.hpp"
+#include "support_plane.hpp"
 
 #include "handtrack/core/hands_tracker.hpp"
 
@@ -71,6 +72,7 @@ class HandSplitter {
   static constexpr size_t kReservedSurfaces = 1024;
 
   MedianFilter median_;
+  SupportPlane support_plane_;
   std::vector<float> volume_;  // median depth in the working volume, 0 outside
   std::vector<int> component_;
   std::vector<int> stack_;

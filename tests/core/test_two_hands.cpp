@@ -119,14 +119,9 @@ TEST(TwoHands, AHandThatLeavesComesBackWithAFreshId) {
   EXPECT_EQ(run.hand(0).identity_swaps, 0);
 }
 
-TEST(TwoHands, OneHandWithRoomForTwoIsTrackedAsWithRoomForOne) {
-  // The same one-hand frames with max_hands 1 and 2 give the same poses, and no second hand; also
-  // when the hand leaves the view (frames 40-44 without depth) and returns: alone, it has left, and
-  // it is found again at once (not held back as a hand hidden behind another).
-  synth::SynthOptions options;
-  options.motion = "fingercount";
-  options.frames = 120;
-  options.seed = kSeed;
+// The same one-hand frames with max_hands 1 and 2 give the same poses, and no second hand; frames
+// [away_from, away_to) have no depth (the hand has left the view).
+void expect_as_with_room_for_one(const synth::SynthOptions& options, int away_from, int away_to) {
   synth::SyntheticCamera camera(options);
   Tracker one(shipped_config(1));  // one hand, as before HandsTracker
   HandsTracker two(shipped_config(2));
@@ -134,7 +129,7 @@ TEST(TwoHands, OneHandWithRoomForTwoIsTrackedAsWithRoomForOne) {
   int phantoms = 0;
   for (int i = 0; i < options.frames; ++i) {
     camera.render(i, frame);
-    const bool away = i >= 40 && i < 45;
+    const bool away = i >= away_from && i < away_to;
     if (away) std::fill(frame.depth.depth_mm.begin(), frame.depth.depth_mm.end(), 0.0F);
     const TrackerOutput a = one.track(frame.depth, &shipped_forest());
     const HandsOutput b = two.track(frame.depth, &shipped_forest());
@@ -148,6 +143,28 @@ TEST(TwoHands, OneHandWithRoomForTwoIsTrackedAsWithRoomForOne) {
     EXPECT_EQ(a.params, b.hands[0].params) << "frame " << i;
   }
   EXPECT_EQ(phantoms, 0);
+}
+
+TEST(TwoHands, OneHandWithRoomForTwoIsTrackedAsWithRoomForOne) {
+  // Also when the hand leaves the view (frames 40-44 without depth) and returns: alone, it has
+  // left, and it is found again at once (not held back as a hand hidden behind another).
+  synth::SynthOptions options;
+  options.motion = "fingercount";
+  options.frames = 120;
+  options.seed = kSeed;
+  expect_as_with_room_for_one(options, 40, 45);
+}
+
+TEST(TwoHands, OneHandOnADeskWithRoomForTwoIsTrackedAsWithRoomForOne) {
+  // Hand and desk are one surface until the desk's plane is taken out (support_plane.hpp), in the
+  // hands' split as in each hand's segmentation: without it in the split, 129 of 150 frames of
+  // this pinch had no hand with max_hands 2.
+  synth::SynthOptions options;
+  options.motion = "pinch";
+  options.frames = 60;
+  options.seed = kSeed;
+  options.background = synth::Background::kDesk;
+  expect_as_with_room_for_one(options, -1, -1);
 }
 
 }  // namespace
