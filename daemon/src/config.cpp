@@ -178,6 +178,13 @@ const std::vector<Field>& fields() {
      "smaller blobs are noise, not a hand", true},
     {"tracker.input.hand_length_mm", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.input.hand_length_mm; }}, 50, 400,
      "wrist to middle fingertip, bounds the hand region", true},
+    {"tracker.input.desk", BoolRef{[](DaemonConfig& c) -> bool& { return c.tracker.input.support_plane.enabled; }}, 0, 0,
+     "take a desk, table or wall the hand touches out of the working volume before segmentation (ours)", true},
+    {"tracker.input.desk_min_area_mm2",
+     DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.input.support_plane.min_area_mm2; }}, 10000, 1e6,
+     "a plane covering more of the working volume than this is a desk, not a hand (mm^2)", true},
+    {"tracker.input.desk_band_mm", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.input.support_plane.band_mm; }},
+     1, 100, "pixels within this of the desk's plane, or beyond it, are the desk's", true},
     // [tracker.energy] (Sec. 4.1, Sec. 4.3)
     {"tracker.energy.w_c", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.collision; }}, 0, 1000,
      "w_c, weight of the collision term E_col (Sec. 4.1: 1.0)", true},
