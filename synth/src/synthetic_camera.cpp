@@ -70,6 +70,19 @@ PlanePatch desk_under(const std::vector<ConeSphere>& primitives, View view) {
   return make_patch(down * (far - kDeskContactMm), -down, 0.0, 0.0);
 }
 
+constexpr double kMaxBallRadiusMm = 100.0;
+// The palm's half thickness (its pieces' radii, hand_model.cpp): a held ball rests on its surface.
+constexpr double kPalmHalfThicknessMm = 13.5;
+
+// A ball of radius r held against the palm: its centre r beyond the palm's surface along the
+// palmar normal (+z of the hand frame: toward the camera when the palm faces it), opposite the
+// palm centre.
+ConeSphere held_ball(const HandShape& shape, const HandPose& pose, double r) {
+  const Vector3d in_hand = shape.palm_centre_mm + Vector3d(0.0, 0.0, kPalmHalfThicknessMm + r);
+  const Vector3d c = pose.translation_mm + camera_R_hand(pose.rotation) * in_hand;
+  return ConeSphere{c, c, r, r, kBackground};
+}
+
 }  // namespace
 
 std::string_view background_name(Background background) {
@@ -177,6 +190,12 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   if (is_two_hand_motion(options.motion) && options.background == Background::kDesk) {
     throw std::invalid_argument("motion '" + options.motion + "': the desk background is for one-hand motions");
   }
+  if (!(options.ball_radius_mm >= 0.0 && options.ball_radius_mm <= kMaxBallRadiusMm)) {
+    throw std::invalid_argument("ball radius must be within [0, 100] mm");
+  }
+  if (is_two_hand_motion(options.motion) && options.ball_radius_mm > 0.0) {
+    throw std::invalid_argument("motion '" + options.motion + "': a held ball is for one-hand motions");
+  }
   std::array<SubjectScale, kTwoHands> subjects;
   if (options.subject) {
     const auto ok = [](double s) { return std::isfinite(s) && s >= 0.5 && s <= 2.0; };
@@ -270,6 +289,7 @@ void SyntheticCamera::render_pose(const HandPose& pose, int frame, SynthFrame& o
   posed_primitives(shape, out.pose, out.joints, s.primitives);
   s.raycaster = s.background;  // same sizes: no allocation
   for (const auto& p : s.primitives) s.raycaster.draw(p);
+  if (s.options.ball_radius_mm > 0.0) s.raycaster.draw(held_ball(shape, out.pose, s.options.ball_radius_mm));
   if (s.options.background == Background::kDesk) s.raycaster.draw(desk_under(s.primitives, s.options.view));
   s.develop(frame, out);
   if (s.options.hand == Handedness::kLeft) mirror(out);

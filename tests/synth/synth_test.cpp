@@ -230,6 +230,42 @@ TEST(SynthNoise, QuantisedAndWithinRange) {
   EXPECT_GT(valid, 10000u);  // the table fills the lower part of the image
 }
 
+TEST(SynthScenes, ADeskUnderTheHandAndABallInIt) {
+  // The desk (Background::kDesk) fills the image behind the hand and touches it: some hand pixel
+  // has a desk pixel beside it less than 10 mm deeper. A held ball covers the palm (label 0, in
+  // front of where the palm was).
+  SynthOptions o = clean_options("pinch", Background::kDesk);
+  SyntheticCamera desk(o);
+  const SynthFrame d = desk.render(60);
+  const int w = d.depth.camera.width;
+  size_t desk_pixels = 0;
+  bool touching = false;
+  for (size_t i = 1; i < d.depth.depth_mm.size(); ++i) {
+    desk_pixels += d.labels.pixels[i] == 0 && d.depth.depth_mm[i] > 0 ? 1 : 0;
+    const bool edge = (d.labels.pixels[i] == 0) != (d.labels.pixels[i - 1] == 0) && i % w != 0;
+    touching = touching || (edge && d.depth.depth_mm[i] > 0 && d.depth.depth_mm[i - 1] > 0 &&
+                            std::abs(d.depth.depth_mm[i] - d.depth.depth_mm[i - 1]) < 10.0F);
+  }
+  EXPECT_GT(desk_pixels, d.depth.depth_mm.size() / 2);
+  EXPECT_TRUE(touching);
+
+  SynthOptions plain = clean_options("pinch");
+  SynthOptions ball = plain;
+  ball.ball_radius_mm = 35.0;
+  const SynthFrame a = SyntheticCamera(plain).render(60);
+  const SynthFrame b = SyntheticCamera(ball).render(60);
+  size_t covered = 0;
+  for (size_t i = 0; i < a.depth.depth_mm.size(); ++i) {
+    const bool ball_over_palm = a.labels.pixels[i] == handtrack::kPalm && b.labels.pixels[i] == 0;
+    covered += ball_over_palm && b.depth.depth_mm[i] < a.depth.depth_mm[i] ? 1 : 0;
+  }
+  EXPECT_GT(covered, 500u);
+  ball.ball_radius_mm = 150.0;
+  EXPECT_THROW(SyntheticCamera{ball}, std::invalid_argument);
+  o.motion = "two_apart";
+  EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);  // the desk is for one-hand motions
+}
+
 TEST(SynthMotions, StayWithinJointLimitsDepthAndImage) {
   const JointLimits limits = JointLimits::defaults();
   for (auto name : kMotionNames) {

@@ -86,6 +86,7 @@ void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticC
                       {"noise", o.noise},
                       {"noise_sigma_k_per_mm", o.noise_params.sigma_k_per_mm},
                       {"background", std::string(handtrack::synth::background_name(o.background))},
+                      {"ball_radius_mm", o.ball_radius_mm},
                       {"pose_parameters", "poses.csv: frame, t_x,t_y,t_z (mm, wrist), r_x,r_y,r_z (axis-angle, "
                                           "R = exp(r) diag(1,-1,-1)), thumb..little abd,flex1,flex2,flex3 (rad)"}};
   if (cam.hand_count() == 1) {
@@ -199,6 +200,9 @@ int main(int argc, char** argv) {
   app.add_flag("--noise,!--no-noise", options.noise, "Sensor noise model on (default) or off");
   app.add_option("--background", background,
                  "Background: body (default; head-mounted view: table), table, desk (the hand rests on it) or none");
+  double ball_radius_mm = 0.0;
+  app.add_option("--ball", ball_radius_mm, "Radius (mm) of a ball held against the palm (default 0: none)")
+      ->check(CLI::Range(0.0, 100.0));
   app.add_option("--hand", hand, "right (default) or left: the right hand's exact mirror image (not with a "
                                  "two-hand motion: it shows both)");
   app.add_option("--view", view, "Camera arrangement (see --list-views): palm (default), back, side, "
@@ -252,6 +256,7 @@ int main(int argc, char** argv) {
     options.motion = motion;
     options.frames = frames;
     options.background = *bg;
+    options.ball_radius_mm = ball_radius_mm;
     options.hand = *handedness;
     options.view = *arrangement;
     options.camera = handtrack::synth::default_camera(width, height);

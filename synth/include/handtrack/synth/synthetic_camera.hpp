@@ -66,6 +66,9 @@ struct SynthOptions {
   NoiseParams noise_params;
   Handedness hand = Handedness::kRight;
   View view = View::kPalm;  // the camera arrangement (views.hpp): the motion turned and placed
+  // > 0: a ball of this radius (mm, at most 100) held against the palm, moving with it (one-hand
+  // motions); not the hand (label 0). The grasping motions close the fingers around it.
+  double ball_radius_mm = 0.0;
 };
 
 // The virtual camera as handtrackd's `synthetic[:MOTION]` source shows it: `frames` per pass of
