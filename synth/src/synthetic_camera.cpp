@@ -49,10 +49,13 @@ PlanePatch make_patch(const Vector3d& origin, const Vector3d& normal, double hal
 // - head-mounted: a table under the hand (the table background's normal (0, -1, -0.5)), touched
 //   by the hand; the forearm comes from above it, near the camera.
 constexpr double kDeskContactMm = 3.0;
+// Up from a table top toward a head-mounted camera (Background::kTable and the head-mounted desk).
+const Vector3d kTableUp = Vector3d(0.0, -1.0, -0.5).normalized();
 
 PlanePatch desk_under(const std::vector<ConeSphere>& primitives, View view) {
   const bool forearm_on_desk = view == View::kPalm || view == View::kBack || view == View::kSide;
-  Vector3d down = view == View::kHeadMounted ? Vector3d(0.0, 1.0, 0.5) : Vector3d(0.0, 0.3, 1.0);  // into the desk
+  // Into the desk.
+  Vector3d down = view == View::kHeadMounted ? Vector3d(-kTableUp) : Vector3d(0.0, 0.3, 1.0);
   if (forearm_on_desk) {
     down = Vector3d::UnitZ();
     for (const auto& p : primitives) {
@@ -187,14 +190,13 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
     throw std::invalid_argument("motion '" + options.motion +
                                 "' shows a right and a left hand in its own arrangement: no hand or view to choose");
   }
-  if (is_two_hand_motion(options.motion) && options.background == Background::kDesk) {
-    throw std::invalid_argument("motion '" + options.motion + "': the desk background is for one-hand motions");
+  const bool one_hand_scene = options.background == Background::kDesk || options.ball_radius_mm > 0.0;
+  if (is_two_hand_motion(options.motion) && one_hand_scene) {
+    throw std::invalid_argument("motion '" + options.motion +
+                                "': the desk background and a held ball are for one-hand motions");
   }
   if (!(options.ball_radius_mm >= 0.0 && options.ball_radius_mm <= kMaxBallRadiusMm)) {
     throw std::invalid_argument("ball radius must be within [0, 100] mm");
-  }
-  if (is_two_hand_motion(options.motion) && options.ball_radius_mm > 0.0) {
-    throw std::invalid_argument("motion '" + options.motion + "': a held ball is for one-hand motions");
   }
   std::array<SubjectScale, kTwoHands> subjects;
   if (options.subject) {
@@ -235,7 +237,7 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
     case Background::kTable:
       // A table top through (0, 250, 750) mm rising away from the camera (normal up and toward the
       // camera): at the bottom of the image ~610 mm, crossing the image centre at ~1 m.
-      planes.push_back(make_patch({0, 250, 750}, {0.0, -1.0, -0.5}, 0.0, 0.0));
+      planes.push_back(make_patch({0, 250, 750}, kTableUp, 0.0, 0.0));
       break;
   }
   s.background.clear();

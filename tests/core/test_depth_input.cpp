@@ -157,12 +157,12 @@ TEST(DepthInput, ASurfaceReachingIntoTheVolumeIsNotAHand) {
 }
 
 // A desk across the whole image rising away toward the top (a plane: 400 mm at the bottom edge,
-// 460 mm in the middle, 540 mm at the top), a hand-sized bump resting on it (up to 25 mm in front of it, its outline on the desk:
-// the depth is continuous from one to the other) and a forearm strip lying on it down to the
-// bottom edge. `in_front_mm` (when not null) gets each pixel's height above the desk.
-DepthImage desk_scene(const CameraIntrinsics& cam, std::vector<float>* in_front_mm = nullptr) {
+// 460 mm in the middle, 540 mm at the top), a hand-sized bump resting on it (up to 25 mm in front
+// of it, its outline on the desk: the depth is continuous from one to the other) and a forearm
+// strip lying on it down to the bottom edge. `in_front_mm` gets each pixel's height above the desk.
+DepthImage desk_scene(const CameraIntrinsics& cam, std::vector<float>& in_front_mm) {
   DepthImage img{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 0.0F)};
-  if (in_front_mm != nullptr) in_front_mm->assign(img.depth_mm.size(), 0.0F);
+  in_front_mm.assign(img.depth_mm.size(), 0.0F);
   const double s = cam.width / 320.0;
   for (int v = 0; v < cam.height; ++v) {
     for (int u = 0; u < cam.width; ++u) {
@@ -174,7 +174,7 @@ DepthImage desk_scene(const CameraIntrinsics& cam, std::vector<float>* in_front_
       if (r2 < 1.0) height = 25.0 * (1.0 - r2);
       if (v > cam.cy + 20 * s && std::abs(u - cam.cx) < 18 * s) height = std::max(height, 15.0);
       img.at(u, v) = static_cast<float>(desk - height);
-      if (in_front_mm != nullptr) (*in_front_mm)[static_cast<size_t>(v) * cam.width + u] = static_cast<float>(height);
+      in_front_mm[static_cast<size_t>(v) * cam.width + u] = static_cast<float>(height);
     }
   }
   return img;
@@ -183,7 +183,7 @@ DepthImage desk_scene(const CameraIntrinsics& cam, std::vector<float>* in_front_
 TEST(DepthInput, AHandOnADeskIsFoundWithoutTheDesk) {
   const auto cam = camera(320, 240);
   std::vector<float> height;
-  const DepthImage img = desk_scene(cam, &height);
+  const DepthImage img = desk_scene(cam, height);
   // Hand and desk are one connected surface: without the plane, the "hand" is no hand or takes in
   // the desk around it.
   DepthInputConfig without;
