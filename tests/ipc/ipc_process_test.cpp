@@ -220,8 +220,11 @@ TEST(IpcProcess, TheCheckerSeesTornRecordsAndMixedHandsWhenTheSeqlockIsBypassed)
   EXPECT_GT(s.at("mixed"), 0) << "reads=" << s.at("reads") << " torn=" << s.at("torn");
 }
 
-// One reader SIGKILLed in the middle of reading, another SIGSTOPped for 5 s: the writer's
-// publish interval p99 does not change; the resumed reader reports what it missed.
+// One reader SIGKILLed in the middle of reading, another SIGSTOPped for 5 s: the writer never
+// waits for them (no publish gap anywhere near the 5 s a reader-held lock would cost, and the
+// publish rate holds); the resumed reader reports what it missed. The interval percentiles are
+// printed, not asserted: on a shared 2-core machine they measure the neighbours (SPEC: speed is
+// reported by benchmarks).
 TEST(IpcProcess, KilledAndStoppedReadersDoNotDisturbTheWriter) {
   ShmGuard shm(unique("slow"));
   const std::string stamps_path = temp_path("slow_stamps");
@@ -262,12 +265,17 @@ TEST(IpcProcess, KilledAndStoppedReadersDoNotDisturbTheWriter) {
   }
   ASSERT_GT(before.size(), 1000U);
   ASSERT_GT(during.size(), 4000U);
-  const double p99_before = percentile(before, 0.99), p99_during = percentile(during, 0.99);
   std::printf("publish interval p50/p99 ms: before %.3f/%.3f, killed+stopped readers %.3f/%.3f\n",
-              percentile(before, 0.5), p99_before, percentile(during, 0.5), p99_during);
-  // 1 ms nominal; scheduling jitter on a busy 2-core machine is the only allowed difference.
-  EXPECT_LT(p99_during, std::max(1.5 * p99_before, p99_before + 0.5));
-  EXPECT_LT(percentile(during, 0.5), 1.1);
+              percentile(before, 0.5), percentile(before, 0.99), percentile(during, 0.5),
+              percentile(during, 0.99));
+  // A writer that waited for the stopped reader would stall for its 5 s, for the killed one
+  // forever; scheduling on a busy machine costs milliseconds. 250 ms separates the two by far.
+  EXPECT_LT(*std::max_element(during.begin(), during.end()), 250.0);
+  // The rate holds: 1 kHz nominal, at least 80 % of the rate seen before the readers misbehaved.
+  const double rate_before = static_cast<double>(before.size()) / (static_cast<double>(a1 - a0) / 1e9);
+  const double rate_during = static_cast<double>(during.size()) / (static_cast<double>(b1 - b0) / 1e9);
+  std::printf("publish rate Hz: before %.0f, killed+stopped readers %.0f\n", rate_before, rate_during);
+  EXPECT_GT(rate_during, 0.8 * rate_before);
 
   const std::string out = sleeper.output();
   const auto s = summary_of(out);

@@ -130,7 +130,8 @@ TEST_F(VirtualDevice, StreamsDepthFramesWithIntrinsicsFromTheDevice) {
     EXPECT_GT(frame.capture_ns, 0);
   }
   const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  EXPECT_LT(seconds, 30 / 60.0 + 0.5) << "30 frames at 60 fps";
+  // 0.5 s at 60 fps; the bound only tells a stalled stream from a busy machine.
+  EXPECT_LT(seconds, 2.0) << "30 frames at 60 fps";
   // The buffer is filled in place once it has the frame's size.
   const uint16_t* data = frame.depth_raw.data();
   ASSERT_EQ(source->grab(frame, 500ms), GrabStatus::kFrame);
@@ -196,7 +197,8 @@ TEST_F(VirtualDevice, GrabReturnsPromptlyWhenUnpluggedDuringALongWait) {
   const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - t0).count();
   puller.join();
   EXPECT_EQ(s, GrabStatus::kDisconnected);
-  EXPECT_LT(ms, 1000) << "grab took " << ms << " ms to notice the unplug";
+  // Against the 10 s timeout it must not sit out; 3 s leaves room for a busy machine.
+  EXPECT_LT(ms, 3000) << "grab took " << ms << " ms to notice the unplug";
   std::printf("unplug noticed %lld ms after the grab started (unplug at ~100 ms)\n", static_cast<long long>(ms));
 }
 
@@ -230,8 +232,10 @@ TEST_F(VirtualDevice, UnplugReplugCyclesLeakNoThreadsOrDescriptors) {
       }
       const auto lost_ms = std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - t0).count();
       ASSERT_EQ(s, GrabStatus::kDisconnected);
-      EXPECT_LT(lost_ms, 500);
-      EXPECT_LE(longest_ms, 400);
+      // Bounds that tell a hang from a busy machine (a grab that ignored its 200 ms timeout would
+      // block until the 3 s loop ends), not latency figures.
+      EXPECT_LT(lost_ms, 2000);
+      EXPECT_LE(longest_ms, 1000);
       source->close();
 
       // While unplugged: open() refuses with the reason, and keeps refusing.
