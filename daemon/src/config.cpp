@@ -117,7 +117,7 @@ const std::vector<Field>& fields() {
      ChoiceRef{[](DaemonConfig& c) { return to_string(c.tracker.handedness); },
                [](DaemonConfig& c, const std::string& v) { return parse_handedness_mode(v, &c.tracker.handedness); },
                "auto, left, right"},
-     0, 0, "auto | left | right: which hand the tracker fits (auto: both at every (re)start, the better kept)",
+     0, 0, "auto | left | right: which hand the tracker fits (auto: both from every (re)start, until several frames tell)",
      true},
     {"tracker.max_hands", IntRef{[](DaemonConfig& c) -> int& { return c.tracker.max_hands; }}, 1, kMaxHands,
      "hands tracked at once (each its own id, handedness and pose; optimized on two cores)", true},

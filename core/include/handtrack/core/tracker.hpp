@@ -91,12 +91,20 @@ struct TrackerConfig {
   int check_iterations_per_frame = 0;
   // A (re)start must explain at least this much of the segmented surface, or there is no hand.
   double min_start_confidence = 0.6;
-  // Auto handedness (Tracker; ours): a hand chosen by less than this confidence margin is not
-  // settled (a fist, a flat hand seen edge-on: both hands explain it), and the other hand is fitted
-  // again from its (re)start every `handedness_check_frames` frames, and at every suspect-confidence
-  // check (above), until one wins by the margin.
-  double handedness_margin = 0.05;
-  int handedness_check_frames = 30;
+  // Auto handedness (Tracker; ours): the hand is chosen by evidence over frames, not on one frame.
+  // From every (re)start both hands are tracked, each by its own PoseTracker, in a trial of at least
+  // `handedness_trial_frames` frames: the evidence is an exponential average (rate
+  // `handedness_evidence_rate`) of the fit-score difference between the left and the right hand,
+  // and the hand it favours is reported. The trial ends, and the other hand is dropped, once the
+  // average is clear by `handedness_margin` after the minimum frames; until then both go on.
+  // Evidence within `handedness_tie` is a tie (Tracker::weigh; a flat hand, depth-only, stays
+  // within +-0.005 from either side), which leaves the hand as the trial's first frame chose it. One
+  // frame's choice was wrong for whole sequences: a fist is explained as well by either hand
+  // (docs/TRACKER.md, "Handedness by evidence over frames").
+  double handedness_margin = 0.15;
+  double handedness_tie = 0.05;
+  int handedness_trial_frames = 30;
+  double handedness_evidence_rate = 0.05;
   // Hands per frame (HandsTracker; 1..kMaxHands): hands_tracker.hpp.
   int max_hands = 2;
   // A surface that a new hand's (re)start found to be no hand is not tried again for this many
@@ -170,8 +178,8 @@ class PoseTracker {
   [[nodiscard]] std::optional<HandHint> hint() const;
   // Optimiser iterations since the last call (TrackerOutput::iterations).
   int take_iterations() { return std::exchange(iterations_, 0); }
-  // No tracked pose, or the next frame starts a check of it (a suspect fit, below).
-  [[nodiscard]] bool in_doubt() const { return !previous_ || check_next_; }
+  // No tracked pose: the next frame (re)starts.
+  [[nodiscard]] bool lost() const { return !previous_; }
   // Optimises the pose for one frame's C_I and updates the history.
   // How a check of a suspect fit is made: its search spread over the next frames (the fit stays
   // the tracked one meanwhile; TrackerConfig::check_iterations_per_frame > 0), or all on this frame.
@@ -318,13 +326,11 @@ class TrackerInputs {
 // u = (width - 1) - cx (pixel centres at integer u). So a left hand is tracked as the right hand of
 // the mirrored image, by a second PoseTracker that only ever sees mirrored inputs, and its joints,
 // fingertips, palm centre and normal are mirrored back (x negated); `params` stay those of the
-// right-hand model in the mirrored image. With HandednessMode::kAuto both hands are fitted at
-// every (re)start (no hand yet, lost, recovering) and the one that explains more of the hand
-// (fit score) is kept; while it tracks, only it runs, except on checks: the tracked hand then
-// competes with the other hand's (re)start, which replaces it when it explains more. Checks come
-// only while the last choice was not clear (TrackerConfig::handedness_margin): every
-// handedness_check_frames frames and at the start of every suspect-fit check (PoseTracker's
-// gross-error check, which is then made at once, not spread over frames).
+// right-hand model in the mirrored image. With HandednessMode::kAuto both hands are fitted from
+// every (re)start of the current hand and tracked side by side in a trial of at least
+// TrackerConfig::handedness_trial_frames frames; the hand that the running fit-score evidence
+// favours is reported, and the other is dropped once the evidence is clear
+// (TrackerConfig::handedness_margin). While only one hand runs, tracking costs what it did.
 //
 // Threading: request() and optimise() on one thread; TrackerInputs::build() anywhere, on inputs
 // the optimising thread does not read at the time.
@@ -355,14 +361,11 @@ class Tracker {
     left_.set_other_hand(as_left);
   }
   // Which hand this one probably is (HandsTracker: not the other hand in view), for choices within
-  // handedness_margin; nullopt: no expectation.
+  // handedness_tie; nullopt: no expectation.
   void expect(std::optional<Handedness> hand) { expected_ = hand; }
-  // Fit both hands again at the next frame (HandsTracker: both hands in view were chosen as the
-  // same hand).
-  void question_handedness() {
-    settled_ = false;
-    frames_since_hand_check_ = config().handedness_check_frames;
-  }
+  // Track both hands again from the next frame, in a new trial (HandsTracker: both hands in view
+  // were chosen as the same hand); a trial under way goes on.
+  void question_handedness() { trial_pending_ = trial_pending_ || trial_frames_ == 0; }
   // Carry on from `last` (a pose this tracker reported) at the next frame, as if it had just been
   // tracked: HandsTracker's way back for a hand hidden behind the other, instead of a (re)start.
   void resume(const TrackerOutput& last);
@@ -370,10 +373,11 @@ class Tracker {
  private:
   [[nodiscard]] const PoseTracker& side(Handedness hand) const { return hand == Handedness::kLeft ? left_ : right_; }
   PoseTracker& side(Handedness hand) { return hand == Handedness::kLeft ? left_ : right_; }
-  // Both hands this frame: a (re)start, a check of an unsettled choice, or a suspect fit.
+  // Both hands this frame: a trial under way or due.
   [[nodiscard]] bool both() const;
-  // Whether hand `a` is the better fit of the frame than hand `b`.
-  [[nodiscard]] bool prefer(const TrackerOutput& a, const TrackerOutput& b) const;
+  // One frame of a handedness trial: the evidence from both hands' fits, the hand it favours
+  // (current_), and the trial's end.
+  void weigh(const TrackerOutput& as_right, const TrackerOutput& as_left);
   TrackerOutput fit(Handedness hand, const DepthInput& input,
                     PoseTracker::CheckPace pace = PoseTracker::CheckPace::kSpread);
   void identify(TrackerOutput& out);  // sets out.hand_id
@@ -383,10 +387,13 @@ class Tracker {
   TrackerInputs inputs_;  // track()'s
   Handedness current_ = Handedness::kRight;
   double handedness_confidence_ = 1.0;
-  bool settled_ = true;                // the last choice of hand was clear (handedness_margin)
   std::optional<Handedness> expected_;  // expect()
-  int frames_since_hand_check_ = 0;
-  bool tracking_ = false;  // the current hand tracked in the last frame
+  // Handedness trial (TrackerConfig::handedness_trial_frames): due at the next frame with both
+  // hands' inputs, its frames so far (0: none under way), and the running evidence (the average
+  // fit-score difference left - right).
+  bool trial_pending_ = true;
+  int trial_frames_ = 0;
+  double evidence_ = 0.0;
   uint32_t hand_id_ = 0;   // of the hand in view; 0: none in the last frame
   uint32_t last_hand_id_ = 0;
 };
