@@ -150,8 +150,9 @@ struct TrackerOutput {
   int iterations = 0;
   bool detection_guided_won = false;  // late fusion: the detection-guided particle won
   Handedness handedness = Handedness::kRight;
-  // How clearly the last choice of hand was made, in [0, 1]: the chosen hand's confidence minus
-  // the other's at that (re)start (1 when only one hand is considered).
+  // How clearly the hand was told apart from the other, in [0, 1]: the running evidence of the
+  // handedness trial (Tracker::weigh: the average fit-score difference of the two hands) as of its
+  // last frame (1 when only one hand is considered).
   double handedness_confidence = 1.0;
   // Which hand this is: a number that stays the same while the hand stays in view (through
   // "recovering" frames and a change of the chosen hand) and is new each time a hand appears after
