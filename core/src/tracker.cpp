@@ -37,6 +37,10 @@ constexpr double kOutOfPlaneAxisMinZ = 0.7;
 constexpr std::array<double, 4> kClosedThumb = {0.3, 0.6, 0.5, 0.5};
 constexpr std::array<double, 4> kClosedFinger = {0.0, 1.3, 1.5, 0.9};
 constexpr double kClosedFingersInFrontMm = 40.0;
+// A hand lost during a handedness trial (Tracker::optimise) is (re)started again every this many
+// frames: on every frame, a hand that found no start made each trial frame cost a whole search
+// (a pipeline frame 9-10 ms instead of 1.5).
+constexpr int kTrialRestartFrames = 5;
 // Pinch strength falls from 1 (tips touching) to 0 at this surface distance.
 constexpr double kPinchOpenMm = 40.0;
 
@@ -260,14 +264,14 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
   if (config().handedness == HandednessMode::kAuto && right != nullptr && left != nullptr && both()) {
     // A trial: both hands, each from its history or its (re)start hypotheses; each hand's
     // suspect-fit checks go at the configured pace, as when it tracks alone. A hand lost later in
-    // the trial is (re)started again on the next frame, a whole search on one frame (10-16 ms), except
-    // with checks spread over frames (the latency setting: no tracked frame runs a whole search),
-    // where it scores 0 for the rest of the trial. Not (re)started, the true hand that found no
-    // start on a fist was lost for good: fingercount 37.2 -> 45.1 mm, handedness 77 -> 60 %.
+    // the trial scores 0 and is (re)started again every kTrialRestartFrames frames, a whole search
+    // on one frame (10-16 ms), except with checks spread over frames (the latency setting: no
+    // tracked frame runs a whole search), where it is not. Never (re)started, the true hand that
+    // found no start on a fist was lost for good: fingercount 37.2 -> 45.1 mm, handedness 77 -> 60 %.
     const bool spread = config().check_iterations_per_frame > 0;
-    const bool first = trial_frames_ == 0;
+    const bool restart_due = trial_frames_ % kTrialRestartFrames == 0;
     const auto trial_fit = [&](Handedness hand, const DepthInput& input) {
-      return spread && !first && side(hand).lost() ? TrackerOutput{} : fit(hand, input);
+      return side(hand).lost() && (spread || !restart_due) && trial_frames_ > 0 ? TrackerOutput{} : fit(hand, input);
     };
     const TrackerOutput as_right = trial_fit(Handedness::kRight, *right);
     const TrackerOutput as_left = trial_fit(Handedness::kLeft, *left);

@@ -206,10 +206,13 @@ TEST(Pipeline, LiveSourceFasterThanTheOptimizerDropsOldestFramesAndStaysFresh) {
     camera.render(static_cast<int>(i), rendered);
     to_raw(rendered.depth, frames[i]);
   }
-  // A "camera" at ~10,000 fps (pre-rendered frames, 0.1 ms apart): far faster than tracking on
-  // any machine, and a stream long enough for several poses.
+  // A "camera" at ~1,000 fps (pre-rendered frames, 1 ms apart): faster than tracking with a
+  // handedness trial (both hands, 2-10 ms a frame) on any machine, and a stream long enough for
+  // many poses after the first frame's (re)start search of both hands (about 50 ms). At 0.1 ms
+  // apart the whole stream passed during that first search and 2 or 3 poses were published, too
+  // few for the median below.
   auto source = std::make_unique<ScriptedSource>(kFrames, true, [&](uint64_t i, RawFrame& f) {
-    std::this_thread::sleep_for(100us);
+    std::this_thread::sleep_for(1ms);
     f = frames[i];
   });
   DaemonConfig config;
