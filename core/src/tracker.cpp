@@ -250,7 +250,6 @@ void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left)
   }
   ++trial_frames_;
   trial_pending_ = false;
-  handedness_confidence_ = std::clamp(std::abs(evidence_), 0.0, 1.0);
   if (trial_frames_ >= config().handedness_trial_frames && std::abs(evidence_) >= config().handedness_margin) {
     side(opposite(current_)).reset();
     trial_frames_ = 0;
@@ -261,7 +260,7 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
   const DepthInput* right = inputs.get(Handedness::kRight);
   const DepthInput* left = inputs.get(Handedness::kLeft);
   TrackerOutput out;
-  if (config().handedness == HandednessMode::kAuto && right != nullptr && left != nullptr && both()) {
+  if (right != nullptr && left != nullptr && both()) {
     // A trial: both hands, each from its history or its (re)start hypotheses; each hand's
     // suspect-fit checks go at the configured pace, as when it tracks alone. A hand lost later in
     // the trial scores 0 and is (re)started again every kTrialRestartFrames frames, a whole search
@@ -269,9 +268,9 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
     // tracked frame runs a whole search), where it is not. Never (re)started, the true hand that
     // found no start on a fist was lost for good: fingercount 37.2 -> 45.1 mm, handedness 77 -> 60 %.
     const bool spread = config().check_iterations_per_frame > 0;
-    const bool restart_due = trial_frames_ % kTrialRestartFrames == 0;
+    const bool restarts = trial_frames_ == 0 || (!spread && trial_frames_ % kTrialRestartFrames == 0);
     const auto trial_fit = [&](Handedness hand, const DepthInput& input) {
-      return side(hand).lost() && (spread || !restart_due) && trial_frames_ > 0 ? TrackerOutput{} : fit(hand, input);
+      return side(hand).lost() && !restarts ? TrackerOutput{} : fit(hand, input);
     };
     const TrackerOutput as_right = trial_fit(Handedness::kRight, *right);
     const TrackerOutput as_left = trial_fit(Handedness::kLeft, *left);
@@ -299,7 +298,9 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
     trial_frames_ = 0;
   }
   out.iterations = right_.take_iterations() + left_.take_iterations();
-  out.handedness_confidence = handedness_confidence_;
+  // 1 when only one hand is considered.
+  out.handedness_confidence =
+      config().handedness == HandednessMode::kAuto ? std::clamp(std::abs(evidence_), 0.0, 1.0) : 1.0;
   identify(out);
   return out;
 }

@@ -1,5 +1,6 @@
 // Left and right hands (Tracker with HandednessMode::kAuto): a left hand is tracked as the right
-// hand of the mirrored image, and the hand is chosen at every (re)start by the better fit.
+// hand of the mirrored image, and the hand is chosen by the fits' evidence over the frames of a
+// trial after every (re)start (Tracker::weigh).
 // - Synthetic left and right hands (the exact mirror image, synth --hand left): tracked as well as
 //   each other, each reported as its own hand.
 // - Real SR305 frames (right hands; ../shared/data, skipped where absent): the same frame mirrored

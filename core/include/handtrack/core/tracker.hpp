@@ -387,11 +387,10 @@ class Tracker {
   PoseTracker left_;
   TrackerInputs inputs_;  // track()'s
   Handedness current_ = Handedness::kRight;
-  double handedness_confidence_ = 1.0;
   std::optional<Handedness> expected_;  // expect()
   // Handedness trial (TrackerConfig::handedness_trial_frames): due at the next frame with both
   // hands' inputs, its frames so far (0: none under way), and the running evidence (the average
-  // fit-score difference left - right).
+  // fit-score difference left - right; TrackerOutput::handedness_confidence is its size).
   bool trial_pending_ = true;
   int trial_frames_ = 0;
   double evidence_ = 0.0;
