@@ -1,9 +1,10 @@
 // DepthInputBuilder: the four steps from a depth image to C_I (paper Sec. 3.1, 4), each in its own
 // unit: median_filter, hand_segmentation, quadtree, image_self_similarity; and, ours, a desk the
-// hand touches taken out before segmentation (support_plane) and the free space around the hand
-// (free_space).
+// hand touches taken out before segmentation (support_plane), the pixels the part labeller calls
+// background taken out of the hand, and the free space around the hand (free_space).
 #include "handtrack/core/depth_input.hpp"
 
+#include "handtrack/core/hand_layout.hpp"
 #include "hand_segmentation.hpp"
 #include "image_self_similarity.hpp"
 #include "median_filter.hpp"
@@ -16,6 +17,18 @@ namespace {
 // Quadtree leaves with room reserved up front: a hand at arm's length makes 200-500 leaves; storage
 // grows only for more (a hand very near the camera).
 constexpr size_t kReservedLeaves = 2048;
+
+// The hand-mask pixels whose part label is the background leave the hand: segmentation keeps
+// whatever surface touches the hand near its palm (a held ball took the palm view from 9 to 51 mm),
+// the forest was trained to tell those pixels from the hand's parts (label 0; data/part_forest.md).
+void drop_background_pixels(DepthInput& input) {
+  for (size_t i = 0; i < input.hand_mask.size(); ++i) {
+    if (input.hand_mask[i] != 0 && input.pixel_labels[i] == kBackground) {
+      input.hand_mask[i] = 0;
+      --input.hand_pixels;
+    }
+  }
+}
 }  // namespace
 
 struct DepthInputBuilder::Steps {
@@ -61,9 +74,12 @@ const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::o
     steps_->support_plane.erase(out_.camera, steps_->without_desk);
     seen = &steps_->without_desk;
   }
-  out_.free_space.build(out_.camera, *seen, out_.hand_mask, config_.free_space);
   out_.pixel_labels.clear();
-  if (labeller != nullptr && out_.hand_pixels > 0) labeller->label(out_, out_.pixel_labels);
+  if (labeller != nullptr && out_.hand_pixels > 0) {
+    labeller->label(out_, out_.pixel_labels);
+    if (config_.drop_background) drop_background_pixels(out_);
+  }
+  out_.free_space.build(out_.camera, *seen, out_.hand_mask, config_.free_space);
   steps_->quadtree.build(config_, steps_->segmenter.hand_box(), out_);
   out_.self_similarity = steps_->self_similarity(out_.gaussians);
   out_.mixture.assign(out_.gaussians);

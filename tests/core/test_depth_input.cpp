@@ -1,5 +1,6 @@
 // Property tests of the depth input (Sec. 3.1): working volume, segmentation, quadtree leaves.
 #include "handtrack/core/depth_input.hpp"
+#include "handtrack/core/hand_layout.hpp"
 #include "handtrack/core/hand_model.hpp"
 #include "handtrack/core/kinematics.hpp"
 
@@ -315,6 +316,52 @@ TEST(DepthInput, ForearmIsCutAtTheWrist) {
   const auto& first = fresh.build(img, std::nullopt);
   ASSERT_TRUE(first.has_hand());
   EXPECT_LT(first.finger_axis.y(), -0.8);  // fingers point up the image, away from the arm
+}
+
+TEST(DepthInput, PixelsLabelledBackgroundLeaveTheHand) {
+  // The blob with its forearm, labelled palm except a disc on the blob (as a held object would be
+  // labelled): with part labels those pixels leave the hand and C_I; with drop_background off, or
+  // without a labeller, they stay.
+  const auto cam = camera(320, 240);
+  const DepthImage img = blob_scene(cam, 400, true);
+  std::vector<uint8_t> labels(img.depth_mm.size(), kPalm);
+  const auto in_disc = [&](int u, int v) { return std::hypot(u - cam.cx, v - (cam.cy - 10)) < 20.0; };
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      if (in_disc(u, v)) labels[static_cast<size_t>(v) * cam.width + u] = kBackground;
+    }
+  }
+  const FixedLabels labeller(&labels);
+  const auto disc_pixels_in_hand = [&](const DepthInput& in) {
+    int n = 0;
+    for (int v = 0; v < cam.height; ++v) {
+      for (int u = 0; u < cam.width; ++u) n += in_disc(u, v) && in.hand_mask[static_cast<size_t>(v) * cam.width + u];
+    }
+    return n;
+  };
+  const auto leaf_area = [](const DepthInput& in) {  // px covered by C_I's leaves
+    int area = 0;
+    for (const auto& g : in.gaussians) area += g.side_px * g.side_px;
+    return area;
+  };
+  DepthInputBuilder plain;
+  const DepthInput kept = plain.build(img, std::nullopt);
+  ASSERT_TRUE(kept.has_hand());
+  EXPECT_GT(disc_pixels_in_hand(kept), 1000);
+
+  DepthInputBuilder dropping;
+  const auto& dropped = dropping.build(img, std::nullopt, &labeller);
+  ASSERT_TRUE(dropped.has_hand());
+  EXPECT_EQ(disc_pixels_in_hand(dropped), 0);
+  EXPECT_EQ(dropped.hand_pixels, kept.hand_pixels - disc_pixels_in_hand(kept));
+  EXPECT_LT(leaf_area(dropped), leaf_area(kept) - disc_pixels_in_hand(kept) / 2) << "C_I leaves the disc out";
+
+  DepthInputConfig keep_config;
+  keep_config.drop_background = false;
+  DepthInputBuilder keeping(keep_config);
+  const auto& labelled = keeping.build(img, std::nullopt, &labeller);
+  EXPECT_EQ(disc_pixels_in_hand(labelled), disc_pixels_in_hand(kept));
+  EXPECT_EQ(leaf_area(labelled), leaf_area(kept));
 }
 
 TEST(Projection, UnprojectInvertsProjectAndSigmaScalesWithInverseDepth) {

@@ -28,6 +28,7 @@ struct ViewCase {
   double max_mean_mm;           // mean fingertip error over the frames with a pose
   double min_handedness_share;  // of the frames with a pose, reported as the hand shown
   synth::Background background = synth::Background::kBody;
+  double ball_radius_mm = 0.0;  // a ball held against the palm (synth --ball)
 };
 
 testing::OneHandRun track_view(const ViewCase& c, const PartForest& forest) {
@@ -38,6 +39,7 @@ testing::OneHandRun track_view(const ViewCase& c, const PartForest& forest) {
   options.hand = c.hand;
   options.view = c.view;
   options.background = c.background;
+  options.ball_radius_mm = c.ball_radius_mm;
   TrackerConfig config;
   config.mode = EnergyMode::kLateFusion;
   return testing::track_one_hand(options, config, &forest);
@@ -50,7 +52,8 @@ TEST_P(EveryView, PinchIsTrackedAsTheHandItIs) {
   const PartForest forest = PartForest::load(shipped_forest_path().value());
   const testing::OneHandRun run = track_view(c, forest);
   const std::string name = std::string(synth::view_name(c.view)) + " " + std::string(synth::handedness_name(c.hand)) +
-                           " on " + std::string(synth::background_name(c.background));
+                           " on " + std::string(synth::background_name(c.background)) +
+                           (c.ball_radius_mm > 0.0 ? " holding a ball" : "");
   std::printf("%s: %.1f mm, %d of %d frames posed, %d as the hand shown\n", name.c_str(), run.mean_error_mm, run.posed,
               kFrames, run.reported_as_shown);
   EXPECT_GE(run.posed, kFrames * 95 / 100) << name << ": a pose in at least 95 % of the frames";
@@ -65,6 +68,7 @@ std::string case_name(const ::testing::TestParamInfo<ViewCase>& info) {
     name += '_';
     name += synth::background_name(info.param.background);
   }
+  if (info.param.ball_radius_mm > 0.0) name += "_ball";
   for (char& ch : name) {
     if (ch == '-') ch = '_';
   }
@@ -77,7 +81,9 @@ std::string case_name(const ::testing::TestParamInfo<ViewCase>& info) {
 // term E_free: palm 5.5 / 4.8, back 16.1 (74 %), side 6.9, fingers-toward 8.5, fingers-away 14.2,
 // head-mounted 28.2 mm (its bound lowered from 55 to 40 mm). With the hand chosen by evidence over
 // frames (Tracker::weigh): back 12.9 mm with 85 % of the frames the right hand (its bounds lowered
-// from 30 to 20 mm and raised from 60 to 80 %), the other views unchanged.
+// from 30 to 20 mm and raised from 60 to 80 %), the other views unchanged. With the forest
+// retrained with held balls and the pixels it calls background dropped: palm 5.9 / 5.6, back 13.6
+// (86 %), side 6.7, fingers-toward 7.5, fingers-away 11.7, head-mounted 26.6 mm.
 INSTANTIATE_TEST_SUITE_P(
     ShippedConfiguration, EveryView,
     ::testing::Values(ViewCase{synth::View::kPalm, synth::Handedness::kRight, 12.0, 0.98},
@@ -99,6 +105,18 @@ INSTANTIATE_TEST_SUITE_P(
                       ViewCase{synth::View::kSide, synth::Handedness::kLeft, 15.0, 0.98, synth::Background::kDesk},
                       ViewCase{synth::View::kBack, synth::Handedness::kRight, 25.0, 0.9, synth::Background::kDesk}),
     case_name);
+
+// A ball (35 mm radius) held against the palm: segmentation keeps it with the hand (it touches the
+// palm), and the pixels the forest labels background leave the hand (DepthInputConfig::
+// drop_background; the shipped forest learnt held balls as background, data/part_forest.md).
+// Measured at seed 21: 15.3 mm; 92.7 mm before (the forest of all views, nothing dropped), 26.3
+// dropping with that forest, 30.8 with the shipped forest and nothing dropped. (Side-on, left hand:
+// 19.0 before, 22.0 mm now; over more subjects the side view gains, 61.0 -> 34.6 mm, docs/TRACKER.md
+// "A held object", but not on this one.)
+INSTANTIATE_TEST_SUITE_P(HoldingABall, EveryView,
+                         ::testing::Values(ViewCase{synth::View::kPalm, synth::Handedness::kRight, 20.0, 0.98,
+                                                    synth::Background::kBody, 35.0}),
+                         case_name);
 
 }  // namespace
 }  // namespace handtrack

@@ -19,6 +19,8 @@ constexpr int kTrainingSequenceFrames = 300;  // motion frames are drawn from 30
 constexpr int kHeldOutSequenceFrames = 241;   // held-out motions: other lengths, so other time samples
 constexpr double kImageSpread = 0.25;         // palm centre within +-25 % of the image size of its centre
 constexpr int kMaxSceneAttempts = 20;
+constexpr double kMinBallMm = 20.0;  // held balls: a golf ball to a large orange (radius)
+constexpr double kMaxBallMm = 45.0;
 
 constexpr std::array<synth::Background, 3> kBackgrounds = {synth::Background::kBody, synth::Background::kTable,
                                                            synth::Background::kNone};
@@ -85,6 +87,9 @@ Scene make_scene(uint64_t seed, uint64_t index, const SceneOptions& options) {
     }
   } else {
     s.pose = random_pose(rng, synth::HandShape::for_subject(*s.options.subject), options);
+  }
+  if (options.ball_fraction > 0.0 && rng.uniform() < options.ball_fraction) {
+    s.options.ball_radius_mm = rng.uniform(kMinBallMm, kMaxBallMm);
   }
   return s;
 }

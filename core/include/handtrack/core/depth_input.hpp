@@ -40,6 +40,9 @@ struct DepthInputConfig {
   double hand_length_mm = 190.0;        // wrist to middle fingertip, bounds the hand region
   FreeSpaceConfig free_space;           // where no part of the hand can be (E_free; ours)
   SupportPlaneConfig support_plane;     // a desk the hand rests on is not the hand (ours)
+  // With part labels (Sec. 4.3): the hand-mask pixels the labeller calls background (a held object,
+  // the forearm beyond the wrist, flying pixels) leave the hand before C_I is built (ours).
+  bool drop_background = true;
 };
 
 // What the tracker knows about where the hand was: lets segmentation keep the hand and cut the
