@@ -18,16 +18,50 @@ namespace {
 // grows only for more (a hand very near the camera).
 constexpr size_t kReservedLeaves = 2048;
 
-// The hand-mask pixels whose part label is the background leave the hand: segmentation keeps
-// whatever surface touches the hand near its palm (a held ball took the palm view from 9 to 51 mm),
-// the forest was trained to tell those pixels from the hand's parts (label 0; data/part_forest.md).
-void drop_background_pixels(DepthInput& input) {
-  for (size_t i = 0; i < input.hand_mask.size(); ++i) {
-    if (input.hand_mask[i] != 0 && input.pixel_labels[i] == kBackground) {
-      input.hand_mask[i] = 0;
-      --input.hand_pixels;
+// The hand-mask pixels labelled background, in 4-connected regions of at least `min_area_mm2`,
+// leave the hand: segmentation keeps whatever surface touches the hand near its palm (a held ball
+// took the palm view from 9 to 51 mm), and the forest was trained to tell those pixels from the
+// hand's parts (label 0; data/part_forest.md). A region's area is the sum of its pixels' z^2 /
+// (f_x f_y). `region` and `stack` are scratch (reused: no allocation once sized).
+void drop_background_regions(DepthInput& input, double min_area_mm2, std::vector<int32_t>& region,
+                             std::vector<int32_t>& stack) {
+  const int w = input.camera.width;
+  const int h = input.camera.height;
+  const auto n = static_cast<size_t>(w) * static_cast<size_t>(h);
+  const double pixel_area = 1.0 / (input.camera.fx * input.camera.fy);
+  const auto background = [&](size_t i) { return input.hand_mask[i] == 1 && input.pixel_labels[i] == kBackground; };
+  for (size_t seed = 0; seed < n; ++seed) {
+    if (!background(seed)) continue;
+    // Flood the region (marking its pixels 2 in the mask), then drop it or give it back.
+    region.clear();
+    stack.assign(1, static_cast<int32_t>(seed));
+    input.hand_mask[seed] = 2;
+    double area = 0.0;
+    while (!stack.empty()) {
+      const auto i = static_cast<size_t>(stack.back());
+      stack.pop_back();
+      region.push_back(static_cast<int32_t>(i));
+      const double z = input.filtered_mm[i];
+      area += z * z * pixel_area;
+      const int u = static_cast<int>(i % static_cast<size_t>(w));
+      const int v = static_cast<int>(i / static_cast<size_t>(w));
+      const auto visit = [&](int uu, int vv) {
+        if (uu < 0 || vv < 0 || uu >= w || vv >= h) return;
+        const size_t j = static_cast<size_t>(vv) * w + uu;
+        if (input.hand_mask[j] != 1 || input.pixel_labels[j] != kBackground) return;
+        input.hand_mask[j] = 2;
+        stack.push_back(static_cast<int32_t>(j));
+      };
+      visit(u - 1, v);
+      visit(u + 1, v);
+      visit(u, v - 1);
+      visit(u, v + 1);
     }
+    const bool drop = area >= min_area_mm2;
+    for (const int32_t i : region) input.hand_mask[static_cast<size_t>(i)] = drop ? 0 : 3;
+    if (drop) input.hand_pixels -= static_cast<int>(region.size());
   }
+  for (uint8_t& m : input.hand_mask) m = m != 0 ? 1 : 0;  // the kept regions (3) back to 1
 }
 }  // namespace
 
@@ -35,6 +69,8 @@ struct DepthInputBuilder::Steps {
   MedianFilter median;
   SupportPlane support_plane;
   std::vector<float> without_desk;  // the median-filtered depth without the desk, for the free space
+  std::vector<int32_t> region;      // drop_background_regions' scratch
+  std::vector<int32_t> stack;
   HandSegmenter segmenter;
   QuadtreeBuilder quadtree;
   SelfSimilarity self_similarity{kReservedLeaves};
@@ -77,7 +113,9 @@ const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::o
   out_.pixel_labels.clear();
   if (labeller != nullptr && out_.hand_pixels > 0) {
     labeller->label(out_, out_.pixel_labels);
-    if (config_.drop_background) drop_background_pixels(out_);
+    if (config_.drop_background) {
+      drop_background_regions(out_, config_.drop_background_min_area_mm2, steps_->region, steps_->stack);
+    }
   }
   out_.free_space.build(out_.camera, *seen, out_.hand_mask, config_.free_space);
   steps_->quadtree.build(config_, steps_->segmenter.hand_box(), out_);

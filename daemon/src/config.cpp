@@ -187,6 +187,9 @@ const std::vector<Field>& fields() {
      1, 100, "pixels within this of the desk's plane, or beyond it, are the desk's", true},
     {"tracker.input.drop_background", BoolRef{[](DaemonConfig& c) -> bool& { return c.tracker.input.drop_background; }}, 0, 0,
      "with the part forest: hand pixels it labels background (a held object, the forearm) leave the hand (ours)", true},
+    {"tracker.input.drop_background_min_area_mm2",
+     DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.input.drop_background_min_area_mm2; }}, 0, 1e6,
+     "only connected background regions at least this large leave the hand (mm^2)", true},
     // [tracker.energy] (Sec. 4.1, Sec. 4.3)
     {"tracker.energy.w_c", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.collision; }}, 0, 1000,
      "w_c, weight of the collision term E_col (Sec. 4.1: 1.0)", true},

@@ -318,24 +318,26 @@ TEST(DepthInput, ForearmIsCutAtTheWrist) {
   EXPECT_LT(first.finger_axis.y(), -0.8);  // fingers point up the image, away from the arm
 }
 
-TEST(DepthInput, PixelsLabelledBackgroundLeaveTheHand) {
-  // The blob with its forearm, labelled palm except a disc on the blob (as a held object would be
-  // labelled): with part labels those pixels leave the hand and C_I; with drop_background off, or
-  // without a labeller, they stay.
+TEST(DepthInput, RegionsLabelledBackgroundLeaveTheHand) {
+  // The blob with its forearm, labelled palm except a disc of 20 px radius (about 39 cm^2 at 400 mm,
+  // as a held ball would be labelled) and a speck of 3 px radius (under 1 cm^2, as the forest
+  // mislabels real depth): with part labels the disc leaves the hand and C_I, the speck stays
+  // (DepthInputConfig::drop_background_min_area_mm2); with drop_background off both stay.
   const auto cam = camera(320, 240);
   const DepthImage img = blob_scene(cam, 400, true);
   std::vector<uint8_t> labels(img.depth_mm.size(), kPalm);
   const auto in_disc = [&](int u, int v) { return std::hypot(u - cam.cx, v - (cam.cy - 10)) < 20.0; };
+  const auto in_speck = [&](int u, int v) { return std::hypot(u - (cam.cx + 12), v - (cam.cy - 38)) < 3.0; };
   for (int v = 0; v < cam.height; ++v) {
     for (int u = 0; u < cam.width; ++u) {
-      if (in_disc(u, v)) labels[static_cast<size_t>(v) * cam.width + u] = kBackground;
+      if (in_disc(u, v) || in_speck(u, v)) labels[static_cast<size_t>(v) * cam.width + u] = kBackground;
     }
   }
   const FixedLabels labeller(&labels);
-  const auto disc_pixels_in_hand = [&](const DepthInput& in) {
+  const auto pixels_in_hand = [&](const DepthInput& in, const auto& inside) {
     int n = 0;
     for (int v = 0; v < cam.height; ++v) {
-      for (int u = 0; u < cam.width; ++u) n += in_disc(u, v) && in.hand_mask[static_cast<size_t>(v) * cam.width + u];
+      for (int u = 0; u < cam.width; ++u) n += inside(u, v) && in.hand_mask[static_cast<size_t>(v) * cam.width + u];
     }
     return n;
   };
@@ -347,20 +349,25 @@ TEST(DepthInput, PixelsLabelledBackgroundLeaveTheHand) {
   DepthInputBuilder plain;
   const DepthInput kept = plain.build(img, std::nullopt);
   ASSERT_TRUE(kept.has_hand());
-  EXPECT_GT(disc_pixels_in_hand(kept), 1000);
+  const int disc = pixels_in_hand(kept, in_disc);
+  const int speck = pixels_in_hand(kept, in_speck);
+  EXPECT_GT(disc, 1000);
+  EXPECT_GT(speck, 20);
 
   DepthInputBuilder dropping;
   const auto& dropped = dropping.build(img, std::nullopt, &labeller);
   ASSERT_TRUE(dropped.has_hand());
-  EXPECT_EQ(disc_pixels_in_hand(dropped), 0);
-  EXPECT_EQ(dropped.hand_pixels, kept.hand_pixels - disc_pixels_in_hand(kept));
-  EXPECT_LT(leaf_area(dropped), leaf_area(kept) - disc_pixels_in_hand(kept) / 2) << "C_I leaves the disc out";
+  EXPECT_EQ(pixels_in_hand(dropped, in_disc), 0);
+  EXPECT_EQ(pixels_in_hand(dropped, in_speck), speck);
+  EXPECT_EQ(dropped.hand_pixels, kept.hand_pixels - disc);
+  EXPECT_LT(leaf_area(dropped), leaf_area(kept) - disc / 2) << "C_I leaves the disc out";
+  for (const uint8_t m : dropped.hand_mask) ASSERT_LE(m, 1);
 
   DepthInputConfig keep_config;
   keep_config.drop_background = false;
   DepthInputBuilder keeping(keep_config);
   const auto& labelled = keeping.build(img, std::nullopt, &labeller);
-  EXPECT_EQ(disc_pixels_in_hand(labelled), disc_pixels_in_hand(kept));
+  EXPECT_EQ(pixels_in_hand(labelled, in_disc), disc);
   EXPECT_EQ(leaf_area(labelled), leaf_area(kept));
 }
 
