@@ -22,13 +22,17 @@ constexpr size_t kReservedLeaves = 2048;
 // leave the hand: segmentation keeps whatever surface touches the hand near its palm (a held ball
 // took the palm view from 9 to 51 mm), and the forest was trained to tell those pixels from the
 // hand's parts (label 0; data/part_forest.md). A region's area is the sum of its pixels' z^2 /
-// (f_x f_y). `region` and `stack` are scratch (reused: no allocation once sized).
+// (f_x f_y). `region` and `stack` are scratch.
 void drop_background_regions(DepthInput& input, double min_area_mm2, std::vector<int32_t>& region,
                              std::vector<int32_t>& stack) {
   const int w = input.camera.width;
   const int h = input.camera.height;
   const auto n = static_cast<size_t>(w) * static_cast<size_t>(h);
   const double pixel_area = 1.0 / (input.camera.fx * input.camera.fy);
+  // Every pixel enters a region and the stack at most once: room for all of them up front, so
+  // that a frame allocates nothing once a frame of its size was seen (the daemon's steady state).
+  if (region.capacity() < n) region.reserve(n);
+  if (stack.capacity() < n) stack.reserve(n);
   const auto background = [&](size_t i) { return input.hand_mask[i] == 1 && input.pixel_labels[i] == kBackground; };
   for (size_t seed = 0; seed < n; ++seed) {
     if (!background(seed)) continue;
