@@ -22,8 +22,9 @@ constexpr size_t kReservedLeaves = 2048;
 // leave the hand: segmentation keeps whatever surface touches the hand near its palm (a held ball
 // took the palm view from 9 to 51 mm), and the forest was trained to tell those pixels from the
 // hand's parts (label 0; data/part_forest.md). A region's area is the sum of its pixels' z^2 /
-// (f_x f_y). `region` and `stack` are scratch.
-void drop_background_regions(DepthInput& input, double min_area_mm2, std::vector<int32_t>& region,
+// (f_x f_y). Only the hand's box (every mask pixel is in it) is scanned. `region` and `stack` are
+// scratch.
+void drop_background_regions(DepthInput& input, const PixelBox& box, double min_area_mm2, std::vector<int32_t>& region,
                              std::vector<int32_t>& stack) {
   const int w = input.camera.width;
   const int h = input.camera.height;
@@ -34,8 +35,13 @@ void drop_background_regions(DepthInput& input, double min_area_mm2, std::vector
   if (region.capacity() < n) region.reserve(n);
   if (stack.capacity() < n) stack.reserve(n);
   const auto background = [&](size_t i) { return input.hand_mask[i] == 1 && input.pixel_labels[i] == kBackground; };
-  for (size_t seed = 0; seed < n; ++seed) {
-    if (!background(seed)) continue;
+  const auto each_box_pixel = [&](const auto& visit_pixel) {
+    for (int v = box.v0; v <= box.v1; ++v) {
+      for (int u = box.u0; u <= box.u1; ++u) visit_pixel(static_cast<size_t>(v) * w + u);
+    }
+  };
+  each_box_pixel([&](size_t seed) {
+    if (!background(seed)) return;
     // Flood the region (marking its pixels 2 in the mask), then drop it or give it back.
     region.clear();
     stack.assign(1, static_cast<int32_t>(seed));
@@ -52,7 +58,7 @@ void drop_background_regions(DepthInput& input, double min_area_mm2, std::vector
       const auto visit = [&](int uu, int vv) {
         if (uu < 0 || vv < 0 || uu >= w || vv >= h) return;
         const size_t j = static_cast<size_t>(vv) * w + uu;
-        if (input.hand_mask[j] != 1 || input.pixel_labels[j] != kBackground) return;
+        if (!background(j)) return;
         input.hand_mask[j] = 2;
         stack.push_back(static_cast<int32_t>(j));
       };
@@ -64,8 +70,8 @@ void drop_background_regions(DepthInput& input, double min_area_mm2, std::vector
     const bool drop = area >= min_area_mm2;
     for (const int32_t i : region) input.hand_mask[static_cast<size_t>(i)] = drop ? 0 : 3;
     if (drop) input.hand_pixels -= static_cast<int>(region.size());
-  }
-  for (uint8_t& m : input.hand_mask) m = m != 0 ? 1 : 0;  // the kept regions (3) back to 1
+  });
+  each_box_pixel([&](size_t i) { input.hand_mask[i] = input.hand_mask[i] != 0 ? 1 : 0; });  // kept regions (3) back to 1
 }
 }  // namespace
 
@@ -118,7 +124,8 @@ const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::o
   if (labeller != nullptr && out_.hand_pixels > 0) {
     labeller->label(out_, out_.pixel_labels);
     if (config_.drop_background) {
-      drop_background_regions(out_, config_.drop_background_min_area_mm2, steps_->region, steps_->stack);
+      drop_background_regions(out_, steps_->segmenter.hand_box(), config_.drop_background_min_area_mm2, steps_->region,
+                              steps_->stack);
     }
   }
   out_.free_space.build(out_.camera, *seen, out_.hand_mask, config_.free_space);
