@@ -97,11 +97,15 @@ DepthInputBuilder::~DepthInputBuilder() = default;
 DepthInputBuilder::DepthInputBuilder(DepthInputBuilder&&) noexcept = default;
 DepthInputBuilder& DepthInputBuilder::operator=(DepthInputBuilder&&) noexcept = default;
 
+const std::vector<float>& DepthInputBuilder::computed_median() const { return steps_->median.last(); }
+
 const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::optional<HandHint>& hint,
-                                           const PixelLabeller* labeller, const std::vector<uint8_t>* foreign) {
+                                           const PixelLabeller* labeller, const std::vector<uint8_t>* foreign,
+                                           const std::vector<float>* given_median) {
   out_.camera = depth.camera;
   // Median, then the working volume (Sec. 4): 0 outside [near, far].
-  const std::vector<float>& median = steps_->median.apply(depth, config_.median_radius_px);
+  const std::vector<float>& median =
+      given_median != nullptr ? *given_median : steps_->median.apply(depth, config_.median_radius_px);
   out_.filtered_mm.resize(median.size());
   const auto near = static_cast<float>(config_.near_mm);
   const auto far = static_cast<float>(config_.far_mm);

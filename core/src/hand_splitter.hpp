@@ -49,6 +49,8 @@ class HandSplitter {
   void split(const DepthInputConfig& config, const DepthImage& depth, const HandsRequest& request,
              std::array<std::vector<uint8_t>, kMaxHands>& foreign, std::array<FrameShare, kMaxHands>& share,
              std::array<std::optional<Eigen::Vector3d>, kMaxHands>& candidate);
+  // The last split's median-filtered frame (what each slot's DepthInputBuilder would compute).
+  [[nodiscard]] const std::vector<float>& median() const { return median_.last(); }
 
  private:
   // Per surface: how many sampled pixels lie within the claim distance of each slot's skeleton,

@@ -47,7 +47,9 @@ uint32_t HandsInputs::share(const DepthImage& depth, const HandsRequest& request
 void HandsInputs::build_slot(int slot, const DepthImage& depth, const HandsRequest& request,
                              const PixelLabeller* labeller) {
   const auto s = static_cast<size_t>(slot);
-  inputs_[s].build(depth, request.slots[s].request, labeller, share_[s] == FrameShare::kWhole ? nullptr : &foreign_[s]);
+  // The splitter's median filter, when it ran (max_hands > 1), is every slot's.
+  inputs_[s].build(depth, request.slots[s].request, labeller, share_[s] == FrameShare::kWhole ? nullptr : &foreign_[s],
+                   request.max_hands > 1 ? &splitter_->median() : nullptr);
 }
 
 HandsTracker::HandsTracker(const TrackerConfig& config)

@@ -13,6 +13,8 @@ class MedianFilter {
   // The median of each (2 radius + 1)^2 window of depth.depth_mm (borders repeat the edge pixel,
   // non-finite samples count as 0); valid until the next call.
   const std::vector<float>& apply(const DepthImage& depth, int radius);
+  // The last apply()'s result.
+  [[nodiscard]] const std::vector<float>& last() const { return out_; }
 
  private:
   void median_3x3(const DepthImage& depth);

@@ -143,15 +143,21 @@ void mirror_output(TrackerOutput& out) {
 TrackerInputs::TrackerInputs(const DepthInputConfig& config) : right_(config), left_(config) {}
 
 void TrackerInputs::build(const DepthImage& depth, const InputRequest& request, const PixelLabeller* labeller,
-                          const std::vector<uint8_t>* foreign) {
+                          const std::vector<uint8_t>* foreign, const std::vector<float>* median) {
   has_right_ = request.right;
   has_left_ = request.left;
-  if (has_right_) right_.build(depth, request.right_hint, labeller, foreign);
+  if (has_right_) {
+    right_.build(depth, request.right_hint, labeller, foreign, median);
+    if (median == nullptr) median = &right_.computed_median();
+  }
   if (has_left_) {
     mirror_depth(depth, mirrored_);
     mirrored_foreign_.resize(depth.depth_mm.size());  // sized with the first left hand, foreign or not
     if (foreign != nullptr) mirror_rows(*foreign, depth.camera.width, mirrored_foreign_);
-    left_.build(mirrored_, request.left_hint, labeller, foreign != nullptr ? &mirrored_foreign_ : nullptr);
+    mirrored_median_.resize(depth.depth_mm.size());  // likewise
+    if (median != nullptr) mirror_rows(*median, depth.camera.width, mirrored_median_);
+    left_.build(mirrored_, request.left_hint, labeller, foreign != nullptr ? &mirrored_foreign_ : nullptr,
+                median != nullptr ? &mirrored_median_ : nullptr);
   }
 }
 

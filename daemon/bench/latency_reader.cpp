@@ -3,7 +3,8 @@
 //   pipeline = publish_ns - capture_ns      (the daemon: grab, queues, preprocess, optimize, publish)
 //   wake     = read time - publish_ns       (the futex wake-up and the seqlock copy in the client)
 //   total    = read time - capture_ns       (frame in to pose readable)
-// and prints p50/p99/max of each as one JSON object.
+// and prints p50/p99/max of each as one JSON object. --trace FILE also writes one CSV row per
+// record (its stage and per-hand times), to see which frames make the tail.
 #include <handtrack/client.hpp>
 
 #include <CLI/CLI.hpp>
@@ -44,11 +45,23 @@ int main(int argc, char** argv) {
   int count = 600;
   int skip = 60;
   double timeout_s = 10.0;
+  std::string trace_path;
   app.add_option("--shm-name", shm_name, "shared-memory object name")->capture_default_str();
   app.add_option("--count", count, "records to measure")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--skip", skip, "records to ignore first (warm-up)")->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--timeout", timeout_s, "give up after S seconds without a record")->capture_default_str();
+  app.add_option("--trace", trace_path, "also write one CSV row per measured record to this file");
   CLI11_PARSE(app, argc, argv);
+  std::FILE* trace = nullptr;
+  if (!trace_path.empty()) {
+    trace = std::fopen(trace_path.c_str(), "w");
+    if (trace == nullptr) {
+      std::perror(("handtrack-latency: " + trace_path).c_str());
+      return 1;
+    }
+    std::fprintf(trace, "frame,hands,preprocess_ms,optimize_ms,hand0_optimize_ms,hand1_optimize_ms,"
+                        "pipeline_ms,wake_ms,total_ms\n");
+  }
 
   handtrack::Client client;
   const int64_t open_deadline = now_ns() + static_cast<int64_t>(timeout_s * 1e9);
@@ -80,7 +93,14 @@ int main(int argc, char** argv) {
     pipeline.push_back(static_cast<double>(frame.publish_ns - frame.capture_ns) * 1e-6);
     wake.push_back(static_cast<double>(read_ns - frame.publish_ns) * 1e-6);
     total.push_back(static_cast<double>(read_ns - frame.capture_ns) * 1e-6);
+    if (trace != nullptr) {
+      std::fprintf(trace, "%llu,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n", static_cast<unsigned long long>(frame.frame),
+                   frame.hand_count, frame.preprocess_ms, frame.optimize_ms,
+                   frame.hand_count > 0 ? frame.hands[0].optimize_ms : 0.0F,
+                   frame.hand_count > 1 ? frame.hands[1].optimize_ms : 0.0F, pipeline.back(), wake.back(), total.back());
+    }
   }
+  if (trace != nullptr) std::fclose(trace);
   std::printf("{\"records\":%zu,\"missed\":%llu,%s,%s,%s}\n", total.size(),
               static_cast<unsigned long long>(client.missed_total()), summary("pipeline_ms", pipeline).c_str(),
               summary("wake_ms", wake).c_str(), summary("total_ms", total).c_str());

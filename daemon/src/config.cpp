@@ -87,6 +87,11 @@ const std::vector<Field>& fields() {
      "frames in one pass of a synthetic motion (slow first half, fast second half)", false},
     {"synthetic.seed", Uint64Ref{[](DaemonConfig& c) -> uint64_t& { return c.source_options.seed; }}, 0, kMaxSeed,
      "subject scale and sensor noise of the synthetic camera", false},
+    {"synthetic.prerender", BoolRef{[](DaemonConfig& c) -> bool& { return c.source_options.synthetic_prerender; }},
+     0, 0,
+     "render one period of frames into memory at start (2 (frames - 1) for one motion, 7 x frames for all; "
+     "320x240: 150 KB each) and replay it, so that frames cost no CPU as a camera's (latency benchmarks)",
+     false},
     // [pipeline]
     {"pipeline.queue_capacity", IntRef{[](DaemonConfig& c) -> int& { return c.pipeline.queue_capacity; }}, 1, 64,
      "frames each queue between two stages holds; the oldest is dropped when the optimizer falls behind", false},

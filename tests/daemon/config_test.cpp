@@ -4,8 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 namespace handtrack::daemon {
 namespace {
@@ -123,6 +125,50 @@ TEST(MakeSource, RefusesMalformedSpecsNamingThem) {
   EXPECT_EQ(make_source("synthetic:pinch", o)->describe(), "synthetic:pinch");
   EXPECT_EQ(make_source("seq:/some/dir", o)->describe(), "seq:/some/dir");
   EXPECT_FALSE(make_source("synthetic", o)->is_live());
+}
+
+// Prerendered, the synthetic camera delivers the frames it renders live (the first period; the
+// first frames of the next one are the period's first frames again).
+TEST(MakeSource, PrerenderedSyntheticFramesAreTheLiveOnes) {
+  SourceOptions live;
+  live.as_fast_as_possible = true;
+  live.synthetic_frames = 4;  // one motion: 0 1 2 3 2 1, then again
+  SourceOptions stored = live;
+  stored.synthetic_prerender = true;
+  auto a = make_source("synthetic:two_apart", live);
+  auto b = make_source("synthetic:two_apart", stored);
+  ASSERT_TRUE(a->open(nullptr));
+  ASSERT_TRUE(b->open(nullptr));
+  std::vector<RawFrame> period;
+  for (int i = 0; i < 8; ++i) {
+    RawFrame fa;
+    RawFrame fb;
+    ASSERT_EQ(a->grab(fa, std::chrono::milliseconds(1000)), GrabStatus::kFrame);
+    ASSERT_EQ(b->grab(fb, std::chrono::milliseconds(1000)), GrabStatus::kFrame);
+    EXPECT_EQ(fb.frame_number, static_cast<uint64_t>(i));
+    EXPECT_EQ(fb.camera.width, fa.camera.width);
+    EXPECT_EQ(fb.camera.cx, fa.camera.cx);
+    if (i < 6) {
+      EXPECT_EQ(fb.depth_raw, fa.depth_raw) << "frame " << i;
+      period.push_back(fb);
+    } else {
+      EXPECT_EQ(fb.depth_raw, period[static_cast<size_t>(i - 6)].depth_raw) << "frame " << i;
+    }
+  }
+  EXPECT_NE(period[0].depth_raw, period[1].depth_raw);
+}
+
+TEST(MakeSource, RefusesAPrerenderTooLargeSayingHowMuch) {
+  SourceOptions o;
+  o.synthetic_prerender = true;
+  o.synthetic_frames = 1'000'000;
+  try {
+    (void)make_source("synthetic:pinch", o);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("synthetic.prerender"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("MiB"), std::string::npos) << e.what();
+  }
 }
 
 TEST(MakeSource, SequenceSourceReportsWhyItCannotOpen) {

@@ -6,7 +6,10 @@
 //
 // Frames are paced at the camera's fps unless options.as_fast_as_possible. Frame i is a pure
 // function of (motion, options.synthetic_frames, options.seed, i): synth::live_camera_options()
-// renders the same frame with its ground truth.
+// renders the same frame with its ground truth. With options.synthetic_prerender the frames of one
+// period (a motion's back-and-forth pass, or all seven motions in turn) are rendered when the
+// source is made, and replayed from memory for ever: a frame then costs the host no CPU, as a
+// camera's does, and only the first period's noise repeats.
 #include "../source_factories.hpp"
 
 #include "handtrack/synth/synthetic_camera.hpp"
@@ -17,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -45,6 +49,7 @@ class SyntheticSource final : public DepthSource {
       }
       cameras_.emplace_back(camera_options(motion, options));
     }
+    if (options.synthetic_prerender) prerender();
   }
 
   [[nodiscard]] std::string describe() const override {
@@ -59,21 +64,14 @@ class SyntheticSource final : public DepthSource {
 
   GrabStatus grab(RawFrame& frame, std::chrono::milliseconds timeout) override {
     if (!pacer_.wait(timeout)) return GrabStatus::kTimeout;
-    const auto frames = static_cast<uint64_t>(options_.synthetic_frames);
-    // All motions: each plays one pass, then the next; one motion: back and forth for ever.
-    auto& camera = cameras_.size() == 1 ? cameras_.front() : cameras_[(index_ / frames) % cameras_.size()];
-    const uint64_t local = cameras_.size() == 1 ? index_ : index_ % frames;
-    camera.render(static_cast<int>(local % (uint64_t{1} << 30)), rendered_);
-    const auto& depth = rendered_.depth;
-    frame.camera = depth.camera;
-    frame.depth_raw.resize(depth.depth_mm.size());  // no reallocation once sized
-    const double per_unit = 1.0 / depth.camera.depth_scale_mm;
-    for (size_t i = 0; i < depth.depth_mm.size(); ++i) {
-      const double d = depth.depth_mm[i];
-      frame.depth_raw[i] = std::isfinite(d) && d > 0.0
-                               ? static_cast<uint16_t>(std::clamp(std::lround(d * per_unit), 0L, 65535L))
-                               : uint16_t{0};
+    if (period_ == 0) {
+      render(index_, frame.depth_raw);
+    } else {  // no reallocation once sized
+      const size_t n = pixels();
+      frame.depth_raw.resize(n);
+      std::memcpy(frame.depth_raw.data(), prerendered_.data() + (index_ % period_) * n, n * sizeof(uint16_t));
     }
+    frame.camera = cameras_.front().camera();
     // Captured when the frame is complete, as a camera delivers it: rendering is the synthetic
     // camera's exposure, not the tracker's latency.
     frame.capture_ns = monotonic_ns();
@@ -85,12 +83,59 @@ class SyntheticSource final : public DepthSource {
   [[nodiscard]] bool is_live() const override { return false; }
 
  private:
+  // The most memory prerendering may take (1 GiB: 7000 frames at 320x240).
+  static constexpr size_t kMaxPrerenderBytes = size_t{1} << 30;
+
+  [[nodiscard]] size_t pixels() const {
+    const auto& cam = cameras_.front().camera();
+    return static_cast<size_t>(cam.width) * static_cast<size_t>(cam.height);
+  }
+
+  // Frame `index` in raw depth units (no reallocation once `raw` is sized).
+  void render(uint64_t index, std::vector<uint16_t>& raw) {
+    const auto frames = static_cast<uint64_t>(options_.synthetic_frames);
+    // All motions: each plays one pass, then the next; one motion: back and forth for ever.
+    auto& camera = cameras_.size() == 1 ? cameras_.front() : cameras_[(index / frames) % cameras_.size()];
+    const uint64_t local = cameras_.size() == 1 ? index : index % frames;
+    camera.render(static_cast<int>(local % (uint64_t{1} << 30)), rendered_);
+    const auto& depth = rendered_.depth;
+    raw.resize(depth.depth_mm.size());
+    const double per_unit = 1.0 / depth.camera.depth_scale_mm;
+    for (size_t i = 0; i < depth.depth_mm.size(); ++i) {
+      const double d = depth.depth_mm[i];
+      raw[i] = std::isfinite(d) && d > 0.0 ? static_cast<uint16_t>(std::clamp(std::lround(d * per_unit), 0L, 65535L))
+                                           : uint16_t{0};
+    }
+  }
+
+  // Frames 0 .. period - 1 into prerendered_: one motion plays 0..N-1, N-2..1 (2N - 2 frames),
+  // all motions one pass each (7N).
+  void prerender() {
+    const auto frames = static_cast<uint64_t>(options_.synthetic_frames);
+    const uint64_t period = cameras_.size() == 1 ? 2 * (frames - 1) : frames * cameras_.size();
+    const size_t bytes = period * pixels() * sizeof(uint16_t);
+    if (bytes > kMaxPrerenderBytes) {
+      throw std::invalid_argument("synthetic.prerender: " + std::to_string(period) + " frames would take " +
+                                  std::to_string(bytes >> 20) + " MiB (at most " +
+                                  std::to_string(kMaxPrerenderBytes >> 20) + "); lower synthetic.frames");
+    }
+    prerendered_.resize(period * pixels());
+    std::vector<uint16_t> raw;
+    for (uint64_t i = 0; i < period; ++i) {
+      render(i, raw);
+      std::copy(raw.begin(), raw.end(), prerendered_.begin() + static_cast<std::ptrdiff_t>(i * pixels()));
+    }
+    period_ = period;
+  }
+
   std::string motion_;
   SourceOptions options_;
   std::vector<synth::SyntheticCamera> cameras_;
   synth::SynthFrame rendered_;
   Pacer pacer_;
   uint64_t index_ = 0;
+  std::vector<uint16_t> prerendered_;  // period_ frames of pixels() raw depths each
+  uint64_t period_ = 0;                // 0: each frame rendered when it is due
 };
 
 }  // namespace

@@ -119,10 +119,16 @@ class DepthInputBuilder {
   // quadtree leaf the majority label of its pixels (Sec. 4.3). `foreign` (one byte per pixel, may be
   // null): pixels that are not this hand's (another hand's: HandsTracker); they stay depth, so that
   // a model part behind another hand counts as hidden, not as floating over nothing, but are never
-  // segmented as the hand. Storage is reused between calls.
+  // segmented as the hand. `median` (may be null): the median-filtered `depth`, when the caller
+  // has it already (config().median_radius_px; another builder's computed_median() of the same
+  // image, or its mirror image for the mirrored image): not filtered again. Storage is reused
+  // between calls.
   const DepthInput& build(const DepthImage& depth, const std::optional<HandHint>& hint,
-                          const PixelLabeller* labeller = nullptr, const std::vector<uint8_t>* foreign = nullptr);
+                          const PixelLabeller* labeller = nullptr, const std::vector<uint8_t>* foreign = nullptr,
+                          const std::vector<float>* median = nullptr);
   [[nodiscard]] const DepthInput& last() const { return out_; }
+  // The median-filtered depth that the last build() computed (not one it was given).
+  [[nodiscard]] const std::vector<float>& computed_median() const;
   [[nodiscard]] const DepthInputConfig& config() const { return config_; }
 
  private:

@@ -301,9 +301,11 @@ struct InputRequest {
 class TrackerInputs {
  public:
   explicit TrackerInputs(const DepthInputConfig& config = {});
-  // `foreign`: pixels that are not this hand's (DepthInputBuilder::build), or null.
+  // `foreign`: pixels that are not this hand's, `median`: the median-filtered frame if the caller
+  // has it (DepthInputBuilder::build), or null. Both hands' inputs share one median filter: the
+  // left hand's is the right hand's mirrored (the 3x3 window and its edge padding are symmetric).
   void build(const DepthImage& depth, const InputRequest& request, const PixelLabeller* labeller = nullptr,
-             const std::vector<uint8_t>* foreign = nullptr);
+             const std::vector<uint8_t>* foreign = nullptr, const std::vector<float>* median = nullptr);
   // Null when not built for this frame.
   [[nodiscard]] const DepthInput* get(Handedness hand) const {
     if (hand == Handedness::kLeft) return has_left_ ? &left_.last() : nullptr;
@@ -315,6 +317,7 @@ class TrackerInputs {
   DepthInputBuilder left_;
   DepthImage mirrored_;
   std::vector<uint8_t> mirrored_foreign_;
+  std::vector<float> mirrored_median_;
   bool has_right_ = false;
   bool has_left_ = false;
 };
