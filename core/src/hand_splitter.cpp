@@ -36,10 +36,17 @@ Skeleton::Skeleton(const Joints& joints) {
     int parent = 0;
     for (int k = 0; k < 4; ++k) {
       const int child = 1 + 4 * f + k;
-      from_[static_cast<size_t>(b)] = joints[static_cast<size_t>(parent)];
-      along_[static_cast<size_t>(b)] = joints[static_cast<size_t>(child)] - joints[static_cast<size_t>(parent)];
-      const double l2 = along_[static_cast<size_t>(b)].squaredNorm();
-      inverse_length2_[static_cast<size_t>(b)] = l2 > 0.0 ? 1.0 / l2 : 0.0;
+      const auto i = static_cast<size_t>(b);
+      const Vector3d& from = joints[static_cast<size_t>(parent)];
+      const Vector3d along = joints[static_cast<size_t>(child)] - from;
+      from_x_[i] = from.x();
+      from_y_[i] = from.y();
+      from_z_[i] = from.z();
+      along_x_[i] = along.x();
+      along_y_[i] = along.y();
+      along_z_[i] = along.z();
+      const double l2 = along.squaredNorm();
+      inverse_length2_[i] = l2 > 0.0 ? 1.0 / l2 : 0.0;
       parent = child;
       ++b;
     }
@@ -49,22 +56,31 @@ Skeleton::Skeleton(const Joints& joints) {
   for (const auto& j : joints) radius_ = std::max(radius_, (j - centre_).norm());
 }
 
-double Skeleton::bone_distance2(size_t b, const Vector3d& p) const {
-  // Nearest point of bone a + t (b - a), t in [0, 1]: t = (p - a).(b - a) / |b - a|^2, clamped.
-  const Vector3d ap = p - from_[b];
-  const double t = std::clamp(ap.dot(along_[b]) * inverse_length2_[b], 0.0, 1.0);
-  return (ap - t * along_[b]).squaredNorm();
+// Nearest point of bone a + t (b - a), t in [0, 1]: t = (p - a).(b - a) / |b - a|^2, clamped.
+[[gnu::always_inline]] inline double Skeleton::bone_distance2(size_t b, double px, double py, double pz) const {
+  const double ax = px - from_x_[b];
+  const double ay = py - from_y_[b];
+  const double az = pz - from_z_[b];
+  const double t = std::clamp((ax * along_x_[b] + ay * along_y_[b] + az * along_z_[b]) * inverse_length2_[b], 0.0, 1.0);
+  const double rx = ax - t * along_x_[b];
+  const double ry = ay - t * along_y_[b];
+  const double rz = az - t * along_z_[b];
+  return rx * rx + ry * ry + rz * rz;
 }
 
 double Skeleton::distance2(const Vector3d& p) const {
   double best = std::numeric_limits<double>::infinity();
-  for (size_t b = 0; b < from_.size(); ++b) best = std::min(best, bone_distance2(b, p));
+  const double px = p.x();
+  const double py = p.y();
+  const double pz = p.z();
+#pragma omp simd reduction(min : best)
+  for (size_t b = 0; b < static_cast<size_t>(kBones); ++b) best = std::min(best, bone_distance2(b, px, py, pz));
   return best;
 }
 
 bool Skeleton::within(const Vector3d& p, double r2) const {
-  for (size_t b = 0; b < from_.size(); ++b) {
-    if (bone_distance2(b, p) < r2) return true;
+  for (size_t b = 0; b < static_cast<size_t>(kBones); ++b) {
+    if (bone_distance2(b, p.x(), p.y(), p.z()) < r2) return true;
   }
   return false;
 }
@@ -72,6 +88,7 @@ bool Skeleton::within(const Vector3d& p, double r2) const {
 HandSplitter::HandSplitter() {
   surfaces_.reserve(kReservedSurfaces);
   claims_.reserve(kReservedSurfaces);
+  decision_.reserve(kReservedSurfaces);
   owner_.reserve(kReservedSurfaces);
   skeletons_.reserve(kMaxHands);
 }
@@ -216,30 +233,50 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
     }
   }
 
-  for (int s = 0; s < kMaxHands; ++s) {
-    if (share[static_cast<size_t>(s)] != FrameShare::kOwn) continue;
-    std::vector<uint8_t>& not_mine = foreign[static_cast<size_t>(s)];
-    const int fresh = new_surface[static_cast<size_t>(s)];
-    for (int v = 0; v < h; ++v) {
-      for (int u = 0; u < w; ++u) {
-        const auto i = static_cast<size_t>(v) * w + u;
-        const int c = component_[i];
-        not_mine[i] = 1;
-        if (c < 0) continue;
-        const int owner = owner_[static_cast<size_t>(c)];
-        bool keep = fresh >= 0 ? c == fresh : owner == s;
-        if (fresh < 0 && owner == kShared && claims_[static_cast<size_t>(c)].samples[static_cast<size_t>(s)] >= kMinClaimSamples) {
-          // Touching hands: each pixel to the hand whose skeleton is nearest.
-          const Vector3d p = unproject(cam, u, v, volume_[i]);
-          const double mine2 = skeletons_[static_cast<size_t>(skeleton_of_[static_cast<size_t>(s)])].distance2(p);
+  // Each slot's foreign mask. Per surface and slot: the slot's, foreign, or (a surface touching
+  // hands share) each pixel to the hand whose skeleton is nearest.
+  decision_.resize(surfaces_.size());
+  for (size_t c = 0; c < surfaces_.size(); ++c) {
+    for (int s = 0; s < kMaxHands; ++s) {
+      const int fresh = new_surface[static_cast<size_t>(s)];
+      const int owner = owner_[c];
+      const bool touching = fresh < 0 && owner == kShared && claims_[c].samples[static_cast<size_t>(s)] >= kMinClaimSamples;
+      decision_[c][static_cast<size_t>(s)] =
+          touching ? kNearest : ((fresh >= 0 ? static_cast<int>(c) == fresh : owner == s) ? kMine : kForeign);
+    }
+  }
+  std::array<bool, kMaxHands> owns{};  // slots that get a mask of their own
+  for (int s = 0; s < kMaxHands; ++s) owns[static_cast<size_t>(s)] = share[static_cast<size_t>(s)] == FrameShare::kOwn;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const auto i = static_cast<size_t>(v) * w + u;
+      const int c = component_[i];
+      const auto* decision = c < 0 ? nullptr : &decision_[static_cast<size_t>(c)];
+      const bool touching = decision != nullptr && owner_[static_cast<size_t>(c)] == kShared &&
+                            std::find(decision->begin(), decision->end(), kNearest) != decision->end();
+      // A touching pixel: its distance to the skeleton of each hand that claims its surface.
+      std::array<double, kMaxHands> distance2{};
+      std::array<bool, kMaxHands> claimant{};
+      if (touching) {
+        const Vector3d p = unproject(cam, u, v, volume_[i]);
+        for (int s = 0; s < kMaxHands; ++s) {
+          const int k = skeleton_of_[static_cast<size_t>(s)];
+          claimant[static_cast<size_t>(s)] =
+              k >= 0 && claims_[static_cast<size_t>(c)].samples[static_cast<size_t>(s)] >= kMinClaimSamples;
+          if (claimant[static_cast<size_t>(s)]) distance2[static_cast<size_t>(s)] = skeletons_[static_cast<size_t>(k)].distance2(p);
+        }
+      }
+      for (int s = 0; s < kMaxHands; ++s) {
+        if (!owns[static_cast<size_t>(s)]) continue;
+        const uint8_t d = decision == nullptr ? kForeign : (*decision)[static_cast<size_t>(s)];
+        bool keep = d == kMine;
+        if (d == kNearest) {  // the pixel is the hand's unless another claimant's skeleton is nearer
           keep = true;
           for (int o = 0; o < kMaxHands; ++o) {
-            const int k = skeleton_of_[static_cast<size_t>(o)];
-            if (o == s || k < 0 || claims_[static_cast<size_t>(c)].samples[static_cast<size_t>(o)] < kMinClaimSamples) continue;
-            keep = keep && mine2 <= skeletons_[static_cast<size_t>(k)].distance2(p);
+            if (o != s && claimant[static_cast<size_t>(o)]) keep = keep && distance2[static_cast<size_t>(s)] <= distance2[static_cast<size_t>(o)];
           }
         }
-        if (keep) not_mine[i] = 0;
+        foreign[static_cast<size_t>(s)][i] = keep ? 0 : 1;
       }
     }
   }

@@ -33,9 +33,10 @@ class Skeleton {
 
  private:
   static constexpr int kBones = 4 * kNumFingers;
-  [[nodiscard]] double bone_distance2(size_t bone, const Eigen::Vector3d& p) const;
-  std::array<Eigen::Vector3d, kBones> from_{};
-  std::array<Eigen::Vector3d, kBones> along_{};  // bone vector
+  [[nodiscard]] double bone_distance2(size_t bone, double px, double py, double pz) const;
+  // Bone b runs from from_*[b] by along_*[b] (structure of arrays: distance2() is one vector loop).
+  std::array<double, kBones> from_x_{}, from_y_{}, from_z_{};
+  std::array<double, kBones> along_x_{}, along_y_{}, along_z_{};
   std::array<double, kBones> inverse_length2_{};
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
   double radius_ = 0.0;
@@ -61,6 +62,10 @@ class HandSplitter {
     Eigen::Vector3d point_sum = Eigen::Vector3d::Zero();
   };
   static constexpr int kShared = -2;  // owner_: claimed by more than one slot
+  // decision_: whose a surface's pixels are, for one slot.
+  static constexpr uint8_t kForeign = 0;
+  static constexpr uint8_t kMine = 1;
+  static constexpr uint8_t kNearest = 2;  // the nearer skeleton's, pixel by pixel (touching hands)
   static constexpr int kNone = -1;
 
   void claim(const DepthInputConfig& config, const CameraIntrinsics& camera, const HandsRequest& request);
@@ -73,6 +78,7 @@ class HandSplitter {
   // otherwise grow its storage frame by frame as it meets more surfaces.
   static constexpr size_t kReservedSurfaces = 1024;
 
+  std::vector<std::array<uint8_t, kMaxHands>> decision_;  // per surface, per slot
   MedianFilter median_;
   SupportPlane support_plane_;
   std::vector<float> volume_;  // median depth in the working volume, 0 outside
