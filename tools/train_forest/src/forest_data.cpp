@@ -142,7 +142,9 @@ std::vector<LabelledImage> make_dataset(uint64_t seed, int count, const SceneOpt
   std::atomic<int> next{0};
   std::atomic<int> done{0};
   const auto work = [&]() {
-    DepthInputBuilder builder;
+    DepthInputConfig volume;
+    volume.far_mm = options.volume_far_mm;
+    DepthInputBuilder builder(volume);
     RenderedScene r;
     for (int i = next++; i < count; i = next++) {
       // Image i is the first of scenes i, i + count, i + 2 count, ... whose hand is big enough.

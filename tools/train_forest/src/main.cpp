@@ -226,6 +226,13 @@ int main(int argc, char** argv) {
   app.add_option("--ball-fraction", scene.ball_fraction,
                  "Share of images with a ball held against the palm (radius 20-45 mm), its pixels background")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--pose-far-mm", scene.far_mm, "Farthest palm depth of the random poses (from 250 mm)")
+      ->check(CLI::Range(300.0, 1500.0))
+      ->capture_default_str();
+  app.add_option("--volume-far-mm", scene.volume_far_mm,
+                 "Far end of the working volume the training frames are segmented in")
+      ->check(CLI::Range(300.0, 1500.0))
+      ->capture_default_str();
   app.add_option("--seed", train.seed, "Seed of the data set and of the training");
   app.add_option("--threads", train.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 256));
   app.add_option("--evaluate", evaluate_model, "Evaluate MODEL on held-out synthetic frames and print the "
@@ -280,7 +287,8 @@ int main(int argc, char** argv) {
             << " --candidates " << train.candidates << " --thresholds " << train.thresholds_per_feature
             << " --min-leaf " << train.min_leaf_samples << " --motion-fraction " << scene.motion_fraction
             << " --turned-fraction " << scene.turned_fraction << " --view-fraction " << scene.view_fraction
-            << " --ball-fraction " << scene.ball_fraction << " --seed " << train.seed;
+            << " --ball-fraction " << scene.ball_fraction << " --pose-far-mm " << scene.far_mm
+            << " --volume-far-mm " << scene.volume_far_mm << " --seed " << train.seed;
     const auto t1 = std::chrono::steady_clock::now();
     progress.restart();
     PartForest model = forest::train_forest(data, scene.camera, train, command.str(), [&](const forest::TrainProgress& p) {

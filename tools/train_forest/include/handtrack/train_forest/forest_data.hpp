@@ -38,6 +38,7 @@ struct SceneOptions {
   double motion_fraction = 0.3;     // share of frames taken from the motion scripts, the rest random poses
   double near_mm = 250.0;           // palm centre depth range of the random poses
   double far_mm = 550.0;
+  double volume_far_mm = 600.0;     // far end of the working volume the training frames are segmented in
   double max_roll_deg = 90.0;       // random poses: rotation about the camera's viewing axis
   double max_pitch_deg = 50.0;      // ... about the camera x axis (tilt toward / away)
   double max_yaw_deg = 60.0;        // ... about the camera y axis
