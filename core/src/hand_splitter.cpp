@@ -252,8 +252,7 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
       const auto i = static_cast<size_t>(v) * w + u;
       const int c = component_[i];
       const auto* decision = c < 0 ? nullptr : &decision_[static_cast<size_t>(c)];
-      const bool touching = decision != nullptr && owner_[static_cast<size_t>(c)] == kShared &&
-                            std::find(decision->begin(), decision->end(), kNearest) != decision->end();
+      const bool touching = decision != nullptr && std::find(decision->begin(), decision->end(), kNearest) != decision->end();
       // A touching pixel: its distance to the skeleton of each hand that claims its surface.
       std::array<double, kMaxHands> distance2{};
       std::array<bool, kMaxHands> claimant{};
