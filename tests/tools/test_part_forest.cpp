@@ -310,6 +310,39 @@ TEST(PartForestTraining, SameSeedSameModelForAnyThreadCount) {
   EXPECT_NE(forest::train_forest(images, synth::default_camera(), o, "m").to_bytes(), two);
 }
 
+// --pose-far-mm: random poses reach that far (the palm centre's depth); --volume-far-mm: their
+// masks too.
+TEST(PartForestTraining, FartherPosesAndWorkingVolumeGiveFartherHands) {
+  forest::SceneOptions o;
+  o.motion_fraction = 0.0;
+  const auto farthest = [&](double far_mm) {
+    o.far_mm = far_mm;
+    double z = 0.0;
+    for (uint64_t i = 0; i < 200; ++i) {
+      const forest::Scene s = forest::make_scene(9, i, o);
+      const synth::HandShape shape = synth::HandShape::for_subject(*s.options.subject);
+      const Eigen::Vector3d palm = s.pose.translation_mm + synth::camera_R_hand(s.pose.rotation) * shape.palm_centre_mm;
+      z = std::max(z, palm.z());
+    }
+    return z;
+  };
+  EXPECT_LE(farthest(550.0), 550.0 + 1e-6);
+  EXPECT_GT(farthest(800.0), 700.0);
+  // --volume-far-mm: the training masks reach that far (the default 600 mm cuts such hands off).
+  const auto deepest_mask_pixel = [&](double volume_far_mm) {
+    o.volume_far_mm = volume_far_mm;
+    float z = 0.0F;
+    for (const auto& img : forest::make_dataset(9, 12, o, 2)) {
+      for (const float d : img.depth_mm) {
+        if (d < forest::kBackgroundDepthMm) z = std::max(z, d);
+      }
+    }
+    return z;
+  };
+  EXPECT_LE(deepest_mask_pixel(600.0), 600.0F);
+  EXPECT_GT(deepest_mask_pixel(850.0), 650.0F);
+}
+
 TEST(SynthRenderPose, RenderingAMotionsPoseEqualsRenderingItsFrame) {
   synth::SynthOptions o;
   o.motion = "tigergrasp";

@@ -21,7 +21,6 @@ constexpr double kImageSpread = 0.25;         // palm centre within +-25 % of th
 constexpr int kMaxSceneAttempts = 20;
 constexpr double kMinBallMm = 20.0;  // held balls: a golf ball to a large orange (radius)
 constexpr double kMaxBallMm = 45.0;
-constexpr double kMaxHintSlideMm = 40.0;  // hinted segmentation: the wrist slid this far at most
 
 constexpr std::array<synth::Background, 3> kBackgrounds = {synth::Background::kBody, synth::Background::kTable,
                                                            synth::Background::kNone};
@@ -92,9 +91,6 @@ Scene make_scene(uint64_t seed, uint64_t index, const SceneOptions& options) {
   if (options.ball_fraction > 0.0 && rng.uniform() < options.ball_fraction) {
     s.options.ball_radius_mm = rng.uniform(kMinBallMm, kMaxBallMm);
   }
-  if (options.hinted_fraction > 0.0 && rng.uniform() < options.hinted_fraction) {
-    s.hint_slide_mm = rng.uniform(0.0, kMaxHintSlideMm);
-  }
   return s;
 }
 
@@ -105,18 +101,7 @@ void render_scene(const Scene& scene, DepthInputBuilder& builder, RenderedScene&
   } else {
     cam.render_pose(scene.pose, scene.frame, out.frame);
   }
-  std::optional<HandHint> hint;
-  if (scene.hint_slide_mm) {
-    // The tracker's hint (PoseTracker::hint) from the true pose: palm centre, wrist, finger axis;
-    // all three moved down the finger axis, toward the forearm.
-    const synth::HandShape& shape = cam.shape(0);
-    const Eigen::Matrix3d r = synth::camera_R_hand(out.frame.pose.rotation);
-    const Eigen::Vector3d axis = r * Eigen::Vector3d::UnitY();
-    const Eigen::Vector3d slide = -*scene.hint_slide_mm * axis;
-    hint = HandHint{out.frame.pose.translation_mm + r * shape.palm_centre_mm + slide,
-                    out.frame.pose.translation_mm + slide, axis};
-  }
-  out.input = builder.build(out.frame.depth, hint);
+  out.input = builder.build(out.frame.depth, std::nullopt);
 }
 
 LabelledImage crop_hand(const DepthInput& input, const std::vector<uint8_t>& truth) {

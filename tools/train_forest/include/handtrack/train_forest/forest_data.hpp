@@ -16,7 +16,6 @@
 #include <array>
 #include <cstdint>
 #include <functional>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -55,12 +54,6 @@ struct SceneOptions {
   // that the tracker can drop them (DepthInputConfig::drop_background). Drawn after everything else
   // in a scene, so 0 leaves the data set of the forests trained before it unchanged.
   double ball_fraction = 0.0;
-  // Share of the images segmented as while tracking: with a hint from the true pose, its wrist slid
-  // 0..kMaxHintSlideMm toward the forearm (a fit that slides down a forearm lets the forearm into
-  // the mask), so that the forearm pixels the tracker's masks keep are learnt as background (label
-  // 0) and dropped (DepthInputConfig::drop_background). Drawn last in a scene, so 0 leaves the
-  // data set unchanged.
-  double hinted_fraction = 0.0;
   CameraIntrinsics camera = synth::default_camera();
 };
 
@@ -69,7 +62,6 @@ struct Scene {
   bool from_motion = false;
   int frame = 0;
   synth::HandPose pose;  // what is rendered
-  std::optional<double> hint_slide_mm;  // segmented with a hint (SceneOptions::hinted_fraction)
 };
 
 // The scene of image `index` of the data set `seed` (deterministic).
@@ -79,8 +71,7 @@ inline constexpr double kMaxTurnedPitchDeg = 80.0;
 // A random pose within the joint limits, placed and rotated as `options` says.
 synth::HandPose random_pose(synth::Rng& rng, const synth::HandShape& shape, const SceneOptions& options);
 
-// Renders a scene and segments it as the tracker does (DepthInputBuilder, with no hint unless the
-// scene has one).
+// Renders a scene and segments it as the tracker does (DepthInputBuilder with no hint).
 struct RenderedScene {
   synth::SynthFrame frame;
   DepthInput input;  // copy of the builder's result
