@@ -88,7 +88,7 @@ bool Skeleton::within(const Vector3d& p, double r2) const {
 HandSplitter::HandSplitter() {
   surfaces_.reserve(kReservedSurfaces);
   claims_.reserve(kReservedSurfaces);
-  decision_.reserve(kReservedSurfaces);
+  ownership_.reserve(kReservedSurfaces);
   owner_.reserve(kReservedSurfaces);
   skeletons_.reserve(kMaxHands);
 }
@@ -235,47 +235,44 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
 
   // Each slot's foreign mask. Per surface and slot: the slot's, foreign, or (a surface touching
   // hands share) each pixel to the hand whose skeleton is nearest.
-  decision_.resize(surfaces_.size());
+  ownership_.resize(surfaces_.size());
   for (size_t c = 0; c < surfaces_.size(); ++c) {
-    for (int s = 0; s < kMaxHands; ++s) {
-      const int fresh = new_surface[static_cast<size_t>(s)];
-      const int owner = owner_[c];
-      const bool touching = fresh < 0 && owner == kShared && claims_[c].samples[static_cast<size_t>(s)] >= kMinClaimSamples;
-      decision_[c][static_cast<size_t>(s)] =
-          touching ? kNearest : ((fresh >= 0 ? static_cast<int>(c) == fresh : owner == s) ? kMine : kForeign);
+    Ownership& own = ownership_[c];
+    own.touching = false;
+    for (size_t s = 0; s < kMaxHands; ++s) {
+      const int fresh = new_surface[s];
+      const bool claims = claims_[c].samples[s] >= kMinClaimSamples;
+      own.claimant[s] = skeleton_of_[s] >= 0 && claims;
+      const bool nearest = fresh < 0 && owner_[c] == kShared && claims;
+      own.slot[s] =
+          nearest ? kNearest : ((fresh >= 0 ? static_cast<int>(c) == fresh : owner_[c] == static_cast<int>(s)) ? kMine : kForeign);
+      own.touching = own.touching || nearest;
     }
   }
-  std::array<bool, kMaxHands> owns{};  // slots that get a mask of their own
-  for (int s = 0; s < kMaxHands; ++s) owns[static_cast<size_t>(s)] = share[static_cast<size_t>(s)] == FrameShare::kOwn;
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const auto i = static_cast<size_t>(v) * w + u;
       const int c = component_[i];
-      const auto* decision = c < 0 ? nullptr : &decision_[static_cast<size_t>(c)];
-      const bool touching = decision != nullptr && std::find(decision->begin(), decision->end(), kNearest) != decision->end();
+      const Ownership* own = c < 0 ? nullptr : &ownership_[static_cast<size_t>(c)];
       // A touching pixel: its distance to the skeleton of each hand that claims its surface.
       std::array<double, kMaxHands> distance2{};
-      std::array<bool, kMaxHands> claimant{};
-      if (touching) {
+      if (own != nullptr && own->touching) {
         const Vector3d p = unproject(cam, u, v, volume_[i]);
-        for (int s = 0; s < kMaxHands; ++s) {
-          const int k = skeleton_of_[static_cast<size_t>(s)];
-          claimant[static_cast<size_t>(s)] =
-              k >= 0 && claims_[static_cast<size_t>(c)].samples[static_cast<size_t>(s)] >= kMinClaimSamples;
-          if (claimant[static_cast<size_t>(s)]) distance2[static_cast<size_t>(s)] = skeletons_[static_cast<size_t>(k)].distance2(p);
+        for (size_t s = 0; s < kMaxHands; ++s) {
+          if (own->claimant[s]) distance2[s] = skeletons_[static_cast<size_t>(skeleton_of_[s])].distance2(p);
         }
       }
-      for (int s = 0; s < kMaxHands; ++s) {
-        if (!owns[static_cast<size_t>(s)]) continue;
-        const uint8_t d = decision == nullptr ? kForeign : (*decision)[static_cast<size_t>(s)];
+      for (size_t s = 0; s < kMaxHands; ++s) {
+        if (share[s] != FrameShare::kOwn) continue;
+        const uint8_t d = own == nullptr ? kForeign : own->slot[s];
         bool keep = d == kMine;
         if (d == kNearest) {  // the pixel is the hand's unless another claimant's skeleton is nearer
           keep = true;
-          for (int o = 0; o < kMaxHands; ++o) {
-            if (o != s && claimant[static_cast<size_t>(o)]) keep = keep && distance2[static_cast<size_t>(s)] <= distance2[static_cast<size_t>(o)];
+          for (size_t o = 0; o < kMaxHands; ++o) {
+            if (o != s && own->claimant[o]) keep = keep && distance2[s] <= distance2[o];
           }
         }
-        foreign[static_cast<size_t>(s)][i] = keep ? 0 : 1;
+        foreign[s][i] = keep ? 0 : 1;
       }
     }
   }

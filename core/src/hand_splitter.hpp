@@ -62,10 +62,17 @@ class HandSplitter {
     Eigen::Vector3d point_sum = Eigen::Vector3d::Zero();
   };
   static constexpr int kShared = -2;  // owner_: claimed by more than one slot
-  // decision_: whose a surface's pixels are, for one slot.
+  // Whose a surface's pixels are, for one slot (Ownership::slot).
   static constexpr uint8_t kForeign = 0;
   static constexpr uint8_t kMine = 1;
   static constexpr uint8_t kNearest = 2;  // the nearer skeleton's, pixel by pixel (touching hands)
+  // Per surface, decided once a frame: whose its pixels are for each slot, the slots whose
+  // skeletons compete for them pixel by pixel, and whether any slot needs that.
+  struct Ownership {
+    std::array<uint8_t, kMaxHands> slot{};
+    std::array<bool, kMaxHands> claimant{};
+    bool touching = false;
+  };
   static constexpr int kNone = -1;
 
   void claim(const DepthInputConfig& config, const CameraIntrinsics& camera, const HandsRequest& request);
@@ -78,7 +85,7 @@ class HandSplitter {
   // otherwise grow its storage frame by frame as it meets more surfaces.
   static constexpr size_t kReservedSurfaces = 1024;
 
-  std::vector<std::array<uint8_t, kMaxHands>> decision_;  // per surface, per slot
+  std::vector<Ownership> ownership_;  // per surface
   MedianFilter median_;
   SupportPlane support_plane_;
   std::vector<float> volume_;  // median depth in the working volume, 0 outside
