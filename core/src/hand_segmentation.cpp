@@ -1,5 +1,7 @@
 #include "hand_segmentation.hpp"
 
+#include "chamfer.hpp"
+
 #include "handtrack/core/hand_model.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -25,36 +27,6 @@ constexpr double kHandLengthMargin = 1.1;
 constexpr double kWristCutMarginMm = 10.0;
 // Pixels this close to the image border mark the end of a blob where the arm leaves the image.
 constexpr int kBorderPx = 3;
-
-// Two-pass 3-4 chamfer distance transform in place: nonzero cells get their distance (in thirds of
-// a pixel) to the nearest zero cell.
-void chamfer_distance(std::vector<int>& d, int w, int h) {
-  const auto at = [&](int u, int v) -> int& { return d[static_cast<size_t>(v) * w + u]; };
-  const auto relax = [&](int u, int v, int du, int dv, int cost) {
-    const int uu = u + du;
-    const int vv = v + dv;
-    const int other = (uu < 0 || vv < 0 || uu >= w || vv >= h) ? 0 : at(uu, vv);
-    at(u, v) = std::min(at(u, v), other + cost);
-  };
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      if (at(u, v) == 0) continue;
-      relax(u, v, -1, 0, 3);
-      relax(u, v, 0, -1, 3);
-      relax(u, v, -1, -1, 4);
-      relax(u, v, 1, -1, 4);
-    }
-  }
-  for (int v = h - 1; v >= 0; --v) {
-    for (int u = w - 1; u >= 0; --u) {
-      if (at(u, v) == 0) continue;
-      relax(u, v, 1, 0, 3);
-      relax(u, v, 0, 1, 3);
-      relax(u, v, 1, 1, 4);
-      relax(u, v, -1, 1, 4);
-    }
-  }
-}
 
 // Whether a 4-neighbour of pixel (u, v) has a measured depth nearer than the working volume: the
 // surface leaves the volume toward the camera there.
@@ -95,11 +67,12 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
   if (foreign != nullptr && foreign->size() == n) {
     for (size_t i = 0; i < n; ++i) own_mm_[i] = (*foreign)[i] != 0 ? 0.0F : out.filtered_mm[i];
   }
-  const auto& d = foreign != nullptr && foreign->size() == n ? own_mm_ : out.filtered_mm;
+  // What is segmented: the filtered depth, or own_mm_ where it differs (foreign pixels, a body).
+  const std::vector<float>* segmented = foreign != nullptr && foreign->size() == n ? &own_mm_ : &out.filtered_mm;
   out.hand_mask.assign(n, 0);
   out.hand_pixels = 0;
   const auto point = [&](size_t i) {
-    return cam.unproject(static_cast<double>(i % w), static_cast<double>(i / w), d[i]);
+    return cam.unproject(static_cast<double>(i % w), static_cast<double>(i / w), (*segmented)[i]);
   };
   const double hand_radius = kHandRadiusInLengths * config.hand_length_mm;
 
@@ -130,7 +103,7 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
     PixelBox near{w, h, -1, -1};
     double tip = -std::numeric_limits<double>::infinity();
     for (int v = 0; v < h; ++v) {
-      const float* row = d.data() + static_cast<size_t>(v) * w;
+      const float* row = segmented->data() + static_cast<size_t>(v) * w;
       const double r_v = ray_v(v);
       for (int u = 0; u < w; ++u) {
         if (u % kScanChunk == 0 && u + kScanChunk <= w && nothing_in(row + u)) {
@@ -154,7 +127,7 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
       for (int u = near.u0; u <= near.u1; ++u) {
         const auto i = static_cast<size_t>(v) * w + u;
         if (!out.hand_mask[i]) continue;
-        const Vector3d p = ray_point(u, r_v, d[i]);
+        const Vector3d p = ray_point(u, r_v, (*segmented)[i]);
         if (p.dot(axis) < cut) {
           out.hand_mask[i] = 0;
           continue;
@@ -174,7 +147,14 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
   if (!found) {
     // No usable hint: the nearest sizeable surface in the working volume is the hand (and maybe
     // its forearm). Label 4-connected surfaces whose neighbouring depths differ < continuity_mm.
-    label_surfaces(config, d, w, h, component_, stack_, blobs_);
+    label_surfaces(config, *segmented, w, h, component_, stack_, blobs_);
+    // A body in the volume: its parts wider than a hand are not the hand (body_eraser.hpp).
+    if (body_.find(config, cam, *segmented, component_, blobs_)) {
+      if (segmented != &own_mm_) std::copy(out.filtered_mm.begin(), out.filtered_mm.end(), own_mm_.begin());
+      segmented = &own_mm_;
+      body_.erase(own_mm_);
+      label_surfaces(config, own_mm_, w, h, component_, stack_, blobs_);
+    }
     int best = -1;
     double best_depth = std::numeric_limits<double>::infinity();
     for (size_t b = 0; b < blobs_.size(); ++b) {
@@ -234,7 +214,7 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
                       beside_near_plane(config, unclamped_mm, w, h, u, v))
                          ? 1
                          : 0;
-      end->depth += d[i];
+      end->depth += (*segmented)[i];
       ++end->pixels;
     }
     const bool top_is_hand = top.border != bottom.border ? top.border < bottom.border
@@ -256,7 +236,7 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
     for (size_t i = 0; i < n; ++i) {
       if (component_[i] == best && (point(i) - mean).dot(axis) >= hi - length) dist[i] = 1 << 20;
     }
-    chamfer_distance(dist, w, h);
+    chamfer_transform(dist, w, h, 0, [&](size_t i) { return dist[i] != 0; });  // distance to the outline
     const auto centre_px = static_cast<size_t>(std::max_element(dist.begin(), dist.end()) - dist.begin());
     centre = point(centre_px);
     // The wrist sits about half a palm below the palm centre.
@@ -272,68 +252,6 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
     std::fill(out.hand_mask.begin(), out.hand_mask.end(), 0);
     out.hand_pixels = 0;
   }
-}
-
-void label_surfaces(const DepthInputConfig& config, const std::vector<float>& d, int w, int h, std::vector<int>& component,
-                    std::vector<int>& stack, std::vector<Surface>& surfaces) {
-  const auto n = static_cast<size_t>(w) * h;
-  component.assign(n, -1);
-  surfaces.clear();
-  for (size_t seed = 0; seed < n; ++seed) {
-    if (d[seed] <= 0.0F || component[seed] >= 0) continue;
-    const int id = static_cast<int>(surfaces.size());
-    Surface surface;
-    stack.clear();
-    stack.push_back(static_cast<int>(seed));
-    component[seed] = id;
-    while (!stack.empty()) {
-      const auto i = static_cast<size_t>(stack.back());
-      stack.pop_back();
-      ++surface.pixels;
-      surface.depth_sum += d[i];
-      const int u = static_cast<int>(i % w);
-      const int v = static_cast<int>(i / w);
-      const auto visit = [&](int uu, int vv) {
-        if (uu < 0 || vv < 0 || uu >= w || vv >= h) return;
-        const auto j = static_cast<size_t>(vv) * w + uu;
-        if (component[j] >= 0 || d[j] <= 0.0F || std::abs(d[j] - d[i]) >= config.continuity_mm) return;
-        component[j] = id;
-        stack.push_back(static_cast<int>(j));
-      };
-      visit(u - 1, v);
-      visit(u + 1, v);
-      visit(u, v - 1);
-      visit(u, v + 1);
-    }
-    surfaces.push_back(surface);
-  }
-}
-
-double far_plane_cut_fraction(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
-                              const std::vector<int>& component, int blob, int w, int h) {
-  const auto far = static_cast<float>(config.far_mm);
-  const auto reach = static_cast<float>(config.far_mm + config.continuity_mm);
-  int boundary = 0;
-  int continued = 0;
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      if (component[static_cast<size_t>(v) * w + u] != blob) continue;
-      bool edge = false;
-      bool beyond = false;
-      for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
-        const int uu = u + du;
-        const int vv = v + dv;
-        if (uu < 0 || vv < 0 || uu >= w || vv >= h) continue;
-        const auto j = static_cast<size_t>(vv) * w + uu;
-        if (component[j] == blob) continue;
-        edge = true;
-        beyond = beyond || (unclamped_mm[j] > far && unclamped_mm[j] <= reach);
-      }
-      boundary += edge ? 1 : 0;
-      continued += beyond ? 1 : 0;
-    }
-  }
-  return boundary > 0 ? static_cast<double>(continued) / boundary : 0.0;
 }
 
 }  // namespace handtrack

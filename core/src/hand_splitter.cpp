@@ -90,6 +90,7 @@ HandSplitter::HandSplitter() {
   claims_.reserve(kReservedSurfaces);
   ownership_.reserve(kReservedSurfaces);
   owner_.reserve(kReservedSurfaces);
+  unclaimed_.reserve(kReservedSurfaces);
   skeletons_.reserve(kMaxHands);
 }
 
@@ -181,6 +182,20 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
   if (support_plane_.find(config.support_plane, cam, volume_)) support_plane_.erase(cam, volume_);
   label_surfaces(config, volume_, w, h, component_, stack_, surfaces_);
   claim(config, cam, request);
+  // A free slot's new hand is not a body: the parts wider than a hand of the surfaces no hand claims
+  // leave the volume (body_eraser.hpp), and what reaches out of them is labelled on its own. (A
+  // claimed surface stays whole: a tracked hand keeps its surface as it finds it.)
+  bool free_slot = false;
+  for (int s = 0; s < request.max_hands; ++s) free_slot = free_slot || !request.slots[static_cast<size_t>(s)].active;
+  if (free_slot) {
+    unclaimed_.resize(surfaces_.size());
+    for (size_t c = 0; c < surfaces_.size(); ++c) unclaimed_[c] = owner_[c] == kNone ? 1 : 0;
+    if (body_.find(config, cam, volume_, component_, surfaces_, &unclaimed_)) {
+      body_.erase(volume_);
+      label_surfaces(config, volume_, w, h, component_, stack_, surfaces_);
+      claim(config, cam, request);
+    }
+  }
 
   // Each slot's surface(s): an active slot its claimed ones, a free slot one new one.
   std::array<int, kMaxHands> new_surface{};

@@ -4,6 +4,7 @@
 // they lie, split pixel by pixel between hands that touch, and the nearest unclaimed surface that
 // could be a hand for each free slot. Private to core (HandsInputs); its scratch is reused from
 // frame to frame.
+#include "body_eraser.hpp"
 #include "hand_segmentation.hpp"
 #include "median_filter.hpp"
 #include "support_plane.hpp"
@@ -80,11 +81,6 @@ class HandSplitter {
   // not where a surface was recently found to be no hand.
   void choose_new(const DepthInputConfig& config, const CameraIntrinsics& camera, const HandsRequest& request);
 
-  // Room for this many surfaces from the start (noise makes dozens of one-pixel surfaces, a hand
-  // and its forearm one or a few): a pipeline's frames each have a splitter, and each would
-  // otherwise grow its storage frame by frame as it meets more surfaces.
-  static constexpr size_t kReservedSurfaces = 1024;
-
   std::vector<Ownership> ownership_;  // per surface
   MedianFilter median_;
   SupportPlane support_plane_;
@@ -94,6 +90,8 @@ class HandSplitter {
   std::vector<Surface> surfaces_;
   std::vector<Claims> claims_;
   std::vector<int> owner_;  // per surface: the owning slot, kShared or kNone
+  std::vector<uint8_t> unclaimed_;  // per surface: owner_ is kNone (BodyEraser::find)
+  BodyEraser body_;
   std::vector<Skeleton> skeletons_;
   std::array<int, kMaxHands> skeleton_of_{};  // slot -> index into skeletons_, -1 when free
 };

@@ -28,13 +28,16 @@ void HandsInputs::build(const DepthImage& depth, const HandsRequest& request, co
 }
 
 uint32_t HandsInputs::share(const DepthImage& depth, const HandsRequest& request) {
-  if (request.max_hands <= 1) {
-    // One hand: the whole frame, exactly as a Tracker alone sees it.
+  // One hand tracked: the whole frame, exactly as a Tracker alone sees it. Else the splitter shares
+  // it out; for one free slot too, so that a surface found to be no hand (a body's fragment nearer
+  // than the hand) is not taken again and again (HandsRequest::rejected).
+  split_ = request.max_hands > 1 || !request.slots[0].active;
+  if (split_) {
+    splitter_->split(config_, depth, request, foreign_, share_, candidate_);
+  } else {
     share_.fill(FrameShare::kNothing);
     share_[0] = FrameShare::kWhole;
     candidate_.fill(std::nullopt);
-  } else {
-    splitter_->split(config_, depth, request, foreign_, share_, candidate_);
   }
   uint32_t slots = 0;
   for (size_t s = 0; s < kMaxHands; ++s) {
@@ -47,9 +50,9 @@ uint32_t HandsInputs::share(const DepthImage& depth, const HandsRequest& request
 void HandsInputs::build_slot(int slot, const DepthImage& depth, const HandsRequest& request,
                              const PixelLabeller* labeller) {
   const auto s = static_cast<size_t>(slot);
-  // The splitter's median filter, when it ran (max_hands > 1), is every slot's.
+  // The splitter's median filter, when it ran, is every slot's.
   inputs_[s].build(depth, request.slots[s].request, labeller, share_[s] == FrameShare::kWhole ? nullptr : &foreign_[s],
-                   request.max_hands > 1 ? &splitter_->median() : nullptr);
+                   split_ ? &splitter_->median() : nullptr);
 }
 
 HandsTracker::HandsTracker(const TrackerConfig& config)

@@ -1,12 +1,15 @@
 // Property tests of the depth input (Sec. 3.1): working volume, segmentation, quadtree leaves.
 #include "handtrack/core/depth_input.hpp"
 #include "handtrack/core/hand_layout.hpp"
+#include "handtrack/core/hands_tracker.hpp"
 #include "handtrack/core/hand_model.hpp"
 #include "handtrack/core/kinematics.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <random>
 
 namespace handtrack {
@@ -244,6 +247,137 @@ TEST(DepthInput, AFlatHandIsNotADesk) {
   const int expected = plain.build(img, std::nullopt).hand_pixels;
   ASSERT_GT(expected, 0);
   EXPECT_EQ(builder.build(img, std::nullopt).hand_pixels, expected);
+}
+
+// A user close to the camera (body_eraser.hpp): the torso, rounded (a sphere of radius 200 mm
+// centred at (torso_x_mm, 0, 540 mm): its front 340 mm away), seen where it is less than
+// 60 mm deeper than its front; the hand, an elliptic bump (about 55 x 80 mm) at 450 mm right of the
+// image centre, with its forearm down to the bottom edge; beyond both, 800 mm. With `arm`, a band
+// joins the torso to the hand, its depth running from one to the other: torso, arm and hand are one
+// surface. Marks each pixel as torso (1) or hand (2; its forearm not) in `part`.
+// hand_alone() is the same scene without the torso (and the arm): what the hand is without them.
+DepthImage body_scene(const CameraIntrinsics& cam, double torso_x_mm, bool arm, std::vector<uint8_t>& part) {
+  const auto n = static_cast<size_t>(cam.width) * cam.height;
+  DepthImage img{cam, std::vector<float>(n, 800.0F)};
+  part.assign(n, 0);
+  const double s = cam.width / 320.0;
+  const double hand_u = cam.cx + 60 * s;
+  const double hand_v = cam.cy - 10 * s;
+  constexpr double kRadius = 200.0;
+  const Eigen::Vector3d centre(torso_x_mm, 0.0, 540.0);
+  const double front = centre.z() - kRadius;
+  // Where the ray through pixel (u, v) meets the sphere (the nearer root), if less than 60 mm
+  // deeper than its front; else 0.
+  const auto torso_depth = [&](double u, double v) {
+    const Eigen::Vector3d ray((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1.0);  // p = z ray
+    const double b = ray.dot(centre);
+    const double disc = b * b - ray.squaredNorm() * (centre.squaredNorm() - kRadius * kRadius);
+    const double z = disc < 0.0 ? 0.0 : (b - std::sqrt(disc)) / ray.squaredNorm();
+    return z < front + 60.0 ? z : 0.0;
+  };
+  // Where the torso ends on the arm's middle row: the arm leaves it there.
+  int join = 0;
+  while (join + 1 < cam.width && torso_depth(join + 1, hand_v) > 0.0) ++join;
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      const auto i = static_cast<size_t>(v) * cam.width + u;
+      const double du = (u - hand_u) / (28.0 * s);
+      const double dv = (v - hand_v) / (40.0 * s);
+      const double r2 = du * du + dv * dv;
+      if (const double z = torso_depth(u, v); z > 0.0) {
+        img.depth_mm[i] = static_cast<float>(z);
+        part[i] = 1;
+      } else if (r2 < 1.0) {
+        img.depth_mm[i] = static_cast<float>(450.0 - 12.0 * (1.0 - r2));
+        part[i] = 2;
+      } else if (v > hand_v + 30 * s && std::abs(u - hand_u) < 18 * s) {
+        img.depth_mm[i] = 460.0F;  // forearm
+      } else if (arm && u > join && u < hand_u && std::abs(v - hand_v) < 15 * s) {
+        const double t = (u - join) / (hand_u - 28.0 * s - join);
+        img.depth_mm[i] = static_cast<float>((1 - t) * torso_depth(join, hand_v) + t * 450.0);
+      }
+    }
+  }
+  return img;
+}
+
+DepthImage hand_alone(const CameraIntrinsics& cam) {
+  std::vector<uint8_t> part;
+  DepthImage img = body_scene(cam, -220.0, false, part);
+  for (size_t i = 0; i < part.size(); ++i) {
+    if (part[i] == 1) img.depth_mm[i] = 800.0F;
+  }
+  return img;
+}
+
+// What of the torso (part 1) and of the hand (part 2) a mask holds.
+std::pair<int, double> torso_pixels_and_hand_share(const std::vector<uint8_t>& mask, const std::vector<uint8_t>& part) {
+  int torso = 0;
+  int hand = 0;
+  int hand_in_mask = 0;
+  for (size_t i = 0; i < part.size(); ++i) {
+    torso += mask[i] != 0 && part[i] == 1 ? 1 : 0;
+    hand += part[i] == 2 ? 1 : 0;
+    hand_in_mask += mask[i] != 0 && part[i] == 2 ? 1 : 0;
+  }
+  return {torso, static_cast<double>(hand_in_mask) / std::max(1, hand)};
+}
+
+TEST(DepthInput, ABodyNearerThanTheHandIsNotTakenForIt) {
+  // The torso's front is 340 mm away, the hand 440-450: the nearest sizeable surface is the body.
+  // The hand is segmented as it is without the body.
+  for (const int width : {320, 640}) {
+    SCOPED_TRACE(width);
+    const auto cam = camera(width, width * 3 / 4);
+    std::vector<uint8_t> part;
+    const DepthImage img = body_scene(cam, -220.0, false, part);
+    DepthInputBuilder alone;
+    const std::vector<uint8_t> expected = alone.build(hand_alone(cam), std::nullopt).hand_mask;
+    DepthInputBuilder builder;
+    const auto& in = builder.build(img, std::nullopt);
+    ASSERT_TRUE(in.has_hand());
+    EXPECT_EQ(torso_pixels_and_hand_share(in.hand_mask, part).first, 0);
+    EXPECT_TRUE(in.hand_mask == expected);
+  }
+}
+
+TEST(DepthInput, AnArmJoinedToABodyIsFollowedToItsHand) {
+  // Torso (front at 340 mm, all of it in the image), arm and hand one surface: the hand is the part
+  // that reaches out of it (without the body eraser, the end of the surface nearer the camera).
+  const auto cam = camera(320, 240);
+  std::vector<uint8_t> part;
+  const DepthImage img = body_scene(cam, -130.0, true, part);
+  DepthInputBuilder builder;
+  const auto& in = builder.build(img, std::nullopt);
+  ASSERT_TRUE(in.has_hand());
+  const auto [torso, hand_share] = torso_pixels_and_hand_share(in.hand_mask, part);
+  EXPECT_LT(torso, in.hand_pixels / 50);  // at most a sliver where the arm leaves the torso
+  EXPECT_GT(hand_share, 0.5);             // the wrist cut takes the hand's lower end, as without the torso
+  const Eigen::Vector3d hand_centre = cam.unproject(cam.cx + 60, cam.cy - 10, 445.0);
+  EXPECT_LT((in.palm_centre_mm - hand_centre).norm(), 40.0) << in.palm_centre_mm.transpose();
+}
+
+TEST(HandsInputs, ANewHandIsNotABody) {
+  // With room for one or two hands and none tracked, a free slot's new surface is the hand, not the
+  // nearer torso: its centroid and pixels are the hand's without the torso.
+  const auto cam = camera(320, 240);
+  std::vector<uint8_t> part;
+  const DepthImage img = body_scene(cam, -220.0, false, part);
+  for (const int max_hands : {1, 2}) {
+    SCOPED_TRACE(max_hands);
+    HandsRequest request;
+    request.max_hands = max_hands;
+    HandsInputs alone;
+    alone.build(hand_alone(cam), request);
+    HandsInputs inputs;
+    inputs.build(img, request);
+    ASSERT_TRUE(alone.has(0) && alone.candidate(0));
+    ASSERT_TRUE(inputs.has(0) && inputs.candidate(0));
+    EXPECT_LT((*inputs.candidate(0) - *alone.candidate(0)).norm(), 1e-9);
+    const auto& mask = inputs.slot(0).get(Handedness::kRight)->hand_mask;
+    EXPECT_EQ(torso_pixels_and_hand_share(mask, part).first, 0);
+    EXPECT_TRUE(mask == alone.slot(0).get(Handedness::kRight)->hand_mask);
+  }
 }
 
 TEST(DepthInput, MedianFilterRemovesFlyingPixels) {

@@ -103,6 +103,7 @@ class HandsInputs {
   std::array<bool, kMaxHands> has_{};
   std::array<FrameShare, kMaxHands> share_{};
   std::array<std::optional<Eigen::Vector3d>, kMaxHands> candidate_{};
+  bool split_ = false;  // share() ran the splitter
 };
 
 // One frame's hands, in slot order (not sorted by id); count of them valid.

@@ -1,0 +1,141 @@
+#include "body_eraser.hpp"
+
+#include "chamfer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+#include <numbers>
+
+namespace handtrack {
+
+namespace {
+// A chamfer distance no surface reaches (and that the transform's + 4 does not overflow).
+constexpr int kFar = 1 << 28;
+}  // namespace
+
+BodyEraser::BodyEraser() {
+  candidate_.reserve(kReservedSurfaces);
+  boxes_.reserve(kReservedSurfaces);
+}
+
+bool BodyEraser::find(const DepthInputConfig& config, const CameraIntrinsics& camera,
+                      const std::vector<float>& depth_mm, const std::vector<int>& component,
+                      const std::vector<Surface>& surfaces, const std::vector<uint8_t>* eligible) {
+  const int w = camera.width;
+  const int h = camera.height;
+  const double radius_mm = kWideHandLengths * config.hand_length_mm;
+  // A surface of less area than the disc cannot hold it: most frames stop here.
+  const double disc_mm2 = std::numbers::pi * radius_mm * radius_mm;
+  opening_.clear();
+  candidate_.assign(surfaces.size(), 0);
+  bool any = false;
+  for (size_t c = 0; c < surfaces.size(); ++c) {
+    candidate_[c] = (eligible == nullptr || (c < eligible->size() && (*eligible)[c] != 0)) &&
+                    surface_area_mm2(camera, surfaces[c].pixels, surfaces[c].mean_depth()) >= disc_mm2;
+    any = any || candidate_[c] != 0;
+  }
+  if (!any) return false;
+  boxes_.assign(surfaces.size(), PixelBox{w, h, -1, -1});
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const int c = component[static_cast<size_t>(v) * w + u];
+      if (c >= 0 && candidate_[static_cast<size_t>(c)] != 0) boxes_[static_cast<size_t>(c)].add(u, v);
+    }
+  }
+  for (size_t c = 0; c < surfaces.size(); ++c) {
+    if (candidate_[c] != 0) add_opening(camera, radius_mm, depth_mm, component, static_cast<int>(c), boxes_[c]);
+  }
+  return !opening_.empty();
+}
+
+void BodyEraser::erase(std::vector<float>& depth_mm) const {
+  for (const size_t i : opening_) depth_mm[i] = 0.0F;
+}
+
+void BodyEraser::add_opening(const CameraIntrinsics& camera, double radius_mm, const std::vector<float>& depth_mm,
+                             const std::vector<int>& component, int c, const PixelBox& box) {
+  const int w = camera.width;
+  const int h = camera.height;
+  // The box with a one-pixel ring: cell (x, y) is pixel (u0 - 1 + x, v0 - 1 + y).
+  const int gw = box.u1 - box.u0 + 3;
+  const int gh = box.v1 - box.v0 + 3;
+  const auto pixel = [&](size_t cell, int* u, int* v) {
+    *u = box.u0 - 1 + static_cast<int>(cell % static_cast<size_t>(gw));
+    *v = box.v0 - 1 + static_cast<int>(cell / static_cast<size_t>(gw));
+    return *u >= 0 && *v >= 0 && *u < w && *v < h;
+  };
+  const auto image_index = [&](int u, int v) { return static_cast<size_t>(v) * w + u; };
+  const size_t cells = static_cast<size_t>(gw) * static_cast<size_t>(gh);
+  // Whose cell: the surface's (open to the transforms), another's (its outline), beyond the image.
+  std::vector<uint8_t>& mine = mine_;
+  mine.resize(cells);
+  grid_.resize(cells);
+  for (size_t k = 0; k < cells; ++k) {
+    int u = 0;
+    int v = 0;
+    const bool in_image = pixel(k, &u, &v);
+    mine[k] = in_image && component[image_index(u, v)] == c ? 1 : 0;
+    // The distance to the outline: 0 on it; beyond the image the surface goes on.
+    grid_[k] = mine[k] != 0 || !in_image ? kFar : 0;
+  }
+  const auto open = [&](size_t k) { return mine[k] != 0; };
+  chamfer_transform(grid_, gw, gh, kFar, open);
+  // The discs' centres: farther from the outline than the disc's radius in pixels at their depth
+  // (the transform counts 3 a pixel). Each starts a disc of that radius: -radius there, so that
+  // the second transform leaves <= 0 on every cell within a disc.
+  bool any = false;
+  for (size_t k = 0; k < cells; ++k) {
+    if (mine[k] == 0) {
+      grid_[k] = kFar;  // a wall: the discs stay within the surface
+      continue;
+    }
+    int u = 0;
+    int v = 0;
+    pixel(k, &u, &v);
+    const double radius_px = radius_mm * camera.focal() / depth_mm[image_index(u, v)];
+    const bool centre = grid_[k] > 3.0 * radius_px;
+    grid_[k] = centre ? -static_cast<int>(std::lround(3.0 * radius_px)) : kFar;
+    any = any || centre;
+  }
+  if (!any) return;
+  chamfer_transform(grid_, gw, gh, kFar, open);
+  // Now > 0 only outside the opening: a third of a pixel for each step beyond it.
+  for (size_t k = 0; k < cells; ++k) {
+    int u = 0;
+    int v = 0;
+    if (mine[k] != 0 && grid_[k] <= 0 && pixel(k, &u, &v)) opening_.push_back(image_index(u, v));
+  }
+  // What is left reaches out of the opening: an arm, a head, or outline the discs just missed
+  // (chamfer lengths are 8 % off, and a disc's size follows its centre's depth, not the outline's).
+  // A part that reaches less than the disc's radius beyond the opening is outline: erased too.
+  for (size_t seed = 0; seed < cells; ++seed) {
+    if (mine[seed] != 1 || grid_[seed] <= 0) continue;
+    part_.clear();
+    stack_.assign(1, seed);
+    mine[seed] = 2;  // visited
+    double reach_mm = 0.0;
+    while (!stack_.empty()) {
+      const size_t k = stack_.back();
+      stack_.pop_back();
+      int u = 0;
+      int v = 0;
+      pixel(k, &u, &v);
+      const size_t i = image_index(u, v);
+      part_.push_back(i);
+      reach_mm = std::max(reach_mm, grid_[k] / 3.0 * depth_mm[i] / camera.focal());
+      const int x = static_cast<int>(k % static_cast<size_t>(gw));
+      const int y = static_cast<int>(k / static_cast<size_t>(gw));
+      for (const auto& [dx, dy] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+        if (x + dx < 0 || y + dy < 0 || x + dx >= gw || y + dy >= gh) continue;
+        const size_t j = static_cast<size_t>(y + dy) * gw + (x + dx);
+        if (mine[j] != 1 || grid_[j] <= 0) continue;
+        mine[j] = 2;
+        stack_.push_back(j);
+      }
+    }
+    if (reach_mm < radius_mm) opening_.insert(opening_.end(), part_.begin(), part_.end());
+  }
+}
+
+}  // namespace handtrack

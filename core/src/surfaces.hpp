@@ -1,0 +1,57 @@
+#pragma once
+// The connected surfaces of the working volume (paper Sec. 4 segments the hand as one): what
+// segmentation, the body eraser and the two-hand splitter share. Private to core.
+#include "handtrack/core/depth_input.hpp"
+
+#include <algorithm>
+#include <vector>
+
+namespace handtrack {
+
+// Room for this many surfaces from the start in per-surface storage (noise makes dozens of
+// one-pixel surfaces, a hand and its forearm one or a few): a pipeline's frames each have their
+// own, and each would otherwise grow it frame by frame as it meets more surfaces.
+inline constexpr size_t kReservedSurfaces = 1024;
+
+// Inclusive pixel bounding box; empty while u1 < u0.
+struct PixelBox {
+  int u0, v0, u1, v1;
+  void add(int u, int v) {
+    u0 = std::min(u0, u);
+    v0 = std::min(v0, v);
+    u1 = std::max(u1, u);
+    v1 = std::max(v1, v);
+  }
+};
+
+// A connected surface of the working volume: 4-neighbours whose depths differ less than
+// DepthInputConfig::continuity_mm.
+struct Surface {
+  int pixels = 0;
+  double depth_sum = 0.0;  // mm, over its pixels
+  [[nodiscard]] double mean_depth() const { return depth_sum / pixels; }
+};
+
+// The area in mm^2 that `pixels` pixels cover at `depth_mm` (each pixel z/f_x by z/f_y).
+inline double surface_area_mm2(const CameraIntrinsics& camera, int pixels, double depth_mm) {
+  return pixels * depth_mm * depth_mm / (camera.fx * camera.fy);
+}
+
+// Labels the connected surfaces of `d` (0 = outside the working volume): component[i] = index into
+// `surfaces`, -1 for no depth. `stack` is scratch. Storage is reused.
+void label_surfaces(const DepthInputConfig& config, const std::vector<float>& d, int w, int h, std::vector<int>& component,
+                    std::vector<int>& stack, std::vector<Surface>& surfaces);
+
+// A surface whose outline runs along the far plane of the working volume for more than this share
+// is a larger surface (a shoulder, a desk) reaching into the volume, not a hand in front of one.
+// Measured: synthetic hands with their forearms 0-0.10, the shoulder of the .oni recording
+// 0.18-0.24; a real hand straddling the far plane (SR305 231615/100: 0.25) is missed until it
+// comes nearer, which is what a working volume means.
+inline constexpr double kMaxFarPlaneCut = 0.15;
+
+// Share of surface `blob`'s outline where the depth (before the working volume: `unclamped_mm`)
+// goes on just beyond the far plane.
+double far_plane_cut_fraction(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
+                              const std::vector<int>& component, int blob, int w, int h);
+
+}  // namespace handtrack
