@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 #include <numbers>
 
 namespace handtrack {
@@ -57,54 +56,52 @@ void BodyEraser::add_opening(const CameraIntrinsics& camera, double radius_mm, c
                              const std::vector<int>& component, int c, const PixelBox& box) {
   const int w = camera.width;
   const int h = camera.height;
-  // The box with a one-pixel ring: cell (x, y) is pixel (u0 - 1 + x, v0 - 1 + y).
+  // The box with a one-pixel ring: cell (x, y) is pixel (u0 - 1 + x, v0 - 1 + y); index -1 for a
+  // cell beyond the image.
   const int gw = box.u1 - box.u0 + 3;
   const int gh = box.v1 - box.v0 + 3;
-  const auto pixel = [&](size_t cell, int* u, int* v) {
-    *u = box.u0 - 1 + static_cast<int>(cell % static_cast<size_t>(gw));
-    *v = box.v0 - 1 + static_cast<int>(cell / static_cast<size_t>(gw));
-    return *u >= 0 && *v >= 0 && *u < w && *v < h;
-  };
-  const auto image_index = [&](int u, int v) { return static_cast<size_t>(v) * w + u; };
   const size_t cells = static_cast<size_t>(gw) * static_cast<size_t>(gh);
+  pixel_.resize(cells);
+  for (int y = 0; y < gh; ++y) {
+    const int v = box.v0 - 1 + y;
+    for (int x = 0; x < gw; ++x) {
+      const int u = box.u0 - 1 + x;
+      const bool in_image = u >= 0 && v >= 0 && u < w && v < h;
+      pixel_[static_cast<size_t>(y) * gw + x] = in_image ? static_cast<ptrdiff_t>(v) * w + u : -1;
+    }
+  }
   // Whose cell: the surface's (open to the transforms), another's (its outline), beyond the image.
   std::vector<uint8_t>& mine = mine_;
   mine.resize(cells);
   grid_.resize(cells);
   for (size_t k = 0; k < cells; ++k) {
-    int u = 0;
-    int v = 0;
-    const bool in_image = pixel(k, &u, &v);
-    mine[k] = in_image && component[image_index(u, v)] == c ? 1 : 0;
+    const ptrdiff_t i = pixel_[k];
+    mine[k] = i >= 0 && component[static_cast<size_t>(i)] == c ? 1 : 0;
     // The distance to the outline: 0 on it; beyond the image the surface goes on.
-    grid_[k] = mine[k] != 0 || !in_image ? kFar : 0;
+    grid_[k] = mine[k] != 0 || i < 0 ? kFar : 0;
   }
   const auto open = [&](size_t k) { return mine[k] != 0; };
   chamfer_transform(grid_, gw, gh, kFar, open);
   // The discs' centres: farther from the outline than the disc's radius in pixels at their depth
   // (the transform counts 3 a pixel). Each starts a disc of that radius: -radius there, so that
   // the second transform leaves <= 0 on every cell within a disc.
+  const double radius_px_mm = 3.0 * radius_mm * camera.focal();  // 3 x the radius in pixels x depth
   bool any = false;
   for (size_t k = 0; k < cells; ++k) {
     if (mine[k] == 0) {
       grid_[k] = kFar;  // a wall: the discs stay within the surface
       continue;
     }
-    int u = 0;
-    int v = 0;
-    pixel(k, &u, &v);
-    const double radius_px = radius_mm * camera.focal() / depth_mm[image_index(u, v)];
-    const bool centre = grid_[k] > 3.0 * radius_px;
-    grid_[k] = centre ? -static_cast<int>(std::lround(3.0 * radius_px)) : kFar;
+    const double radius = radius_px_mm / depth_mm[static_cast<size_t>(pixel_[k])];
+    const bool centre = grid_[k] > radius;
+    grid_[k] = centre ? -static_cast<int>(std::lround(radius)) : kFar;
     any = any || centre;
   }
   if (!any) return;
   chamfer_transform(grid_, gw, gh, kFar, open);
   // Now > 0 only outside the opening: a third of a pixel for each step beyond it.
   for (size_t k = 0; k < cells; ++k) {
-    int u = 0;
-    int v = 0;
-    if (mine[k] != 0 && grid_[k] <= 0 && pixel(k, &u, &v)) opening_.push_back(image_index(u, v));
+    if (mine[k] != 0 && grid_[k] <= 0) opening_.push_back(static_cast<size_t>(pixel_[k]));
   }
   // What is left reaches out of the opening: an arm, a head, or outline the discs just missed
   // (chamfer lengths are 8 % off, and a disc's size follows its centre's depth, not the outline's).
@@ -118,17 +115,11 @@ void BodyEraser::add_opening(const CameraIntrinsics& camera, double radius_mm, c
     while (!stack_.empty()) {
       const size_t k = stack_.back();
       stack_.pop_back();
-      int u = 0;
-      int v = 0;
-      pixel(k, &u, &v);
-      const size_t i = image_index(u, v);
+      const auto i = static_cast<size_t>(pixel_[k]);
       part_.push_back(i);
       reach_mm = std::max(reach_mm, grid_[k] / 3.0 * depth_mm[i] / camera.focal());
-      const int x = static_cast<int>(k % static_cast<size_t>(gw));
-      const int y = static_cast<int>(k / static_cast<size_t>(gw));
-      for (const auto& [dx, dy] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
-        if (x + dx < 0 || y + dy < 0 || x + dx >= gw || y + dy >= gh) continue;
-        const size_t j = static_cast<size_t>(y + dy) * gw + (x + dx);
+      // Surface cells are never on the grid's ring: their 4-neighbours are cells of the grid.
+      for (const size_t j : {k - 1, k + 1, k - static_cast<size_t>(gw), k + static_cast<size_t>(gw)}) {
         if (mine[j] != 1 || grid_[j] <= 0) continue;
         mine[j] = 2;
         stack_.push_back(j);

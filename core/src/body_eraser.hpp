@@ -21,6 +21,7 @@
 // Private to core (HandSegmenter, HandSplitter); its scratch is reused from frame to frame.
 #include "surfaces.hpp"
 
+#include <cstddef>
 #include <vector>
 
 namespace handtrack {
@@ -29,10 +30,10 @@ class BodyEraser {
  public:
   BodyEraser();
 
-  // The disc's radius in hand lengths (DepthInputConfig::hand_length_mm). The widest disc inside a
-  // hand measured 0.14-0.26 hand lengths on the benchmark's renders (every view and motion, seeds
-  // 1-6: 26-49 mm, the forearm and the largest subjects included) and 0.16-0.25 on the SR305 hands;
-  // a torso 0.48-0.66 (92-126 mm), a head 0.22-0.25 (not wide).
+  // The disc's radius in hand lengths (DepthInputConfig::hand_length_mm: 76 mm). The widest disc
+  // inside a hand measured at most 49 mm (0.26 hand lengths) on the benchmark's renders (every view
+  // and motion, seeds 1, 4 and 6, the forearm and the largest subjects included) and 31-48 mm on
+  // the SR305 hands; on the SR305 frames a torso 92-126 mm, a head 42-48 mm (not wide).
   static constexpr double kWideHandLengths = 0.4;
 
   // Finds the opening of every surface c of `component` / `surfaces` (as label_surfaces() made them
@@ -54,6 +55,7 @@ class BodyEraser {
   std::vector<uint8_t> candidate_;  // per surface: eligible and of more area than the disc
   std::vector<PixelBox> boxes_;     // per surface: its pixels' box (candidates only)
   std::vector<int> grid_;           // the box plus a one-pixel ring: chamfer distances
+  std::vector<ptrdiff_t> pixel_;    // per grid cell: its image index, -1 beyond the image
   std::vector<uint8_t> mine_;       // per grid cell: the surface's own
   std::vector<size_t> opening_;     // the openings' pixels (image indices)
   std::vector<size_t> part_;        // a part left of a surface (image indices)

@@ -15,28 +15,31 @@ namespace handtrack {
 template <typename Open>
 void chamfer_transform(std::vector<int>& d, int w, int h, int outside, Open open) {
   const auto at = [&](int u, int v) -> int& { return d[static_cast<size_t>(v) * w + u]; };
-  const auto relax = [&](int u, int v, int du, int dv, int cost) {
+  // A cell's neighbour; only cells on the grid's edge look beyond it.
+  const auto relax = [&](int u, int v, int du, int dv, int cost, bool edge) {
     const int uu = u + du;
     const int vv = v + dv;
-    const int other = (uu < 0 || vv < 0 || uu >= w || vv >= h) ? outside : at(uu, vv);
+    const int other = edge && (uu < 0 || vv < 0 || uu >= w || vv >= h) ? outside : at(uu, vv);
     at(u, v) = std::min(at(u, v), other + cost);
   };
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       if (!open(static_cast<size_t>(v) * w + u)) continue;
-      relax(u, v, -1, 0, 3);
-      relax(u, v, 0, -1, 3);
-      relax(u, v, -1, -1, 4);
-      relax(u, v, 1, -1, 4);
+      const bool edge = u == 0 || v == 0 || u == w - 1 || v == h - 1;
+      relax(u, v, -1, 0, 3, edge);
+      relax(u, v, 0, -1, 3, edge);
+      relax(u, v, -1, -1, 4, edge);
+      relax(u, v, 1, -1, 4, edge);
     }
   }
   for (int v = h - 1; v >= 0; --v) {
     for (int u = w - 1; u >= 0; --u) {
       if (!open(static_cast<size_t>(v) * w + u)) continue;
-      relax(u, v, 1, 0, 3);
-      relax(u, v, 0, 1, 3);
-      relax(u, v, 1, 1, 4);
-      relax(u, v, -1, 1, 4);
+      const bool edge = u == 0 || v == 0 || u == w - 1 || v == h - 1;
+      relax(u, v, 1, 0, 3, edge);
+      relax(u, v, 0, 1, 3, edge);
+      relax(u, v, 1, 1, 4, edge);
+      relax(u, v, -1, 1, 4, edge);
     }
   }
 }

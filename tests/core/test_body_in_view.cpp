@@ -6,7 +6,8 @@
 //
 // Measured (docs/TRACKER.md, "Real frames"): before the body eraser, in 231615/200 the hand was
 // never found, with room for one hand or two (the torso, nearer by its mean depth, was taken for it,
-// or its head with two); now it is, in 20 of 20 frames with two, and 15 of 20 with one. What is
+// or its head with two); now it is, in 20 of 20 frames with two, and 19 of 20 with one (the first
+// frame tries a fragment of the body nearer than the hand, which fits no hand). What is
 // not fixed and not asserted: with two, the head or a fragment of the body is fitted as a second
 // hand in most frames (confidence 0.65-0.86, as high as a real hand's).
 #include "handtrack/core/hands_tracker.hpp"
@@ -58,7 +59,7 @@ TEST(BodyInView, TheRaisedHandIsFoundBesideABodyAsNearAsIt) {
   }
   // With room for one hand: a surface whose (re)start found no hand is passed over for the next.
   const auto raw = read_png_gray16(dir / "200.png");
-  EXPECT_GE(frames_with_the_hand(DepthImage::from_raw(cam, raw.pixels), 1, 20), 12);
+  EXPECT_GE(frames_with_the_hand(DepthImage::from_raw(cam, raw.pixels), 1, 20), 15);
 }
 
 }  // namespace
