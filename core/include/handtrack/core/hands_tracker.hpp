@@ -10,8 +10,10 @@
 //      so the wrist cut works as for one hand); the pixels of a surface claimed by several hands
 //      (touching, clasped or clapping hands) go to the hand whose skeleton is nearest.
 //   3. A free slot takes the nearest unclaimed surface that could be a hand (big enough, not a
-//      body reaching in through the far plane); a new hand therefore appears only apart from the
-//      hands already tracked, and one that touches a tracked hand waits until they part.
+//      body reaching in through the far plane, not the part of a body wider than any hand); a new
+//      hand therefore appears only apart from the hands already tracked, and one that touches a
+//      tracked hand waits until they part. With room for one hand, a free slot is given its
+//      surface so too (a surface found to be no hand is passed over); a tracked one the whole frame.
 //   4. Each slot's Tracker sees the frame with every pixel but its own marked foreign: never its
 //      hand, but still depth (a hand behind the other is hidden there, not floating over nothing),
 //      and fits it exactly as it fits a single hand.
