@@ -98,12 +98,14 @@ std::string_view background_name(Background background) {
       return "table";
     case Background::kDesk:
       return "desk";
+    case Background::kNearBody:
+      return "near-body";
   }
   return "none";
 }
 
 std::optional<Background> parse_background(std::string_view name) {
-  for (auto b : {Background::kNone, Background::kBody, Background::kTable, Background::kDesk}) {
+  for (auto b : {Background::kNone, Background::kBody, Background::kTable, Background::kDesk, Background::kNearBody}) {
     if (background_name(b) == name) return b;
   }
   return std::nullopt;
@@ -233,6 +235,15 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
       background_solids.push_back(ConeSphere{{30, -270, 810}, {30, -270, 810}, 95.0, 95.0, kBackground});
       break;
     case Background::kDesk:  // drawn with the hand, in every frame (desk_under)
+      break;
+    case Background::kNearBody:
+      // The torso as a capsule of radius 220 mm (rounded: no plane for the tracker's desk
+      // detection) whose top, seen in the lower half of the image, is 430-600 mm away; neck and a
+      // head of radius 75 mm (485-560 mm) above it: inside the tracker's 150-600 mm working volume,
+      // just behind the hand and touching its forearm.
+      background_solids.push_back(ConeSphere{{30, 330, 640}, {30, 900, 640}, 220.0, 220.0, kBackground});
+      background_solids.push_back(ConeSphere{{30, -100, 590}, {30, 110, 620}, 45.0, 45.0, kBackground});
+      background_solids.push_back(ConeSphere{{30, -170, 560}, {30, -170, 560}, 75.0, 75.0, kBackground});
       break;
     case Background::kTable:
       // A table top through (0, 250, 750) mm rising away from the camera (normal up and toward the

@@ -266,6 +266,25 @@ TEST(SynthScenes, ADeskUnderTheHandAndABallInIt) {
   EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);  // the desk is for one-hand motions
 }
 
+TEST(SynthScenes, ANearBodyIsInsideTheWorkingVolumeBehindTheHand) {
+  // Background::kNearBody: what is not the hand (label 0: the forearm, torso and head) covers more
+  // of the tracker's 150-600 mm working volume than a hand and forearm can (400 cm^2); with the
+  // body background only the forearm is there.
+  const auto not_hand_in_volume_mm2 = [](Background bg) {
+    const SynthFrame f = SyntheticCamera(clean_options("pinch", bg)).render(60);
+    const auto& cam = f.depth.camera;
+    double area = 0.0;
+    for (size_t i = 0; i < f.depth.depth_mm.size(); ++i) {
+      const float z = f.depth.depth_mm[i];
+      if (f.labels.pixels[i] == 0 && z >= 150.0F && z <= 600.0F) area += static_cast<double>(z) * z / (cam.fx * cam.fy);
+    }
+    return area;
+  };
+  EXPECT_GT(not_hand_in_volume_mm2(Background::kNearBody), 40000.0);
+  EXPECT_LT(not_hand_in_volume_mm2(Background::kBody), 10000.0);
+  EXPECT_EQ(parse_background("near-body"), Background::kNearBody);
+}
+
 TEST(SynthMotions, StayWithinJointLimitsDepthAndImage) {
   const JointLimits limits = JointLimits::defaults();
   for (auto name : kMotionNames) {

@@ -199,7 +199,8 @@ int main(int argc, char** argv) {
                                              "from the seed within +-10%)");
   app.add_flag("--noise,!--no-noise", options.noise, "Sensor noise model on (default) or off");
   app.add_option("--background", background,
-                 "Background: body (default; head-mounted view: table), table, desk (the hand rests on it) or none");
+                 "Background: body (default; head-mounted view: table), table, desk (the hand rests on it), "
+                 "near-body (a user close to the camera: torso and head inside the working volume) or none");
   double ball_radius_mm = 0.0;
   app.add_option("--ball", ball_radius_mm, "Radius (mm) of a ball held against the palm (default 0: none)")
       ->check(CLI::Range(0.0, 100.0));
@@ -248,7 +249,7 @@ int main(int argc, char** argv) {
   if (!arrangement) return fail("unknown view '" + view + "' (see --list-views)");
   if (background.empty()) background = *arrangement == handtrack::synth::View::kHeadMounted ? "table" : "body";
   const auto bg = handtrack::synth::parse_background(background);
-  if (!bg) return fail("--background must be body, table, desk or none, got '" + background + "'");
+  if (!bg) return fail("--background must be body, table, desk, near-body or none, got '" + background + "'");
   const auto handedness = handtrack::synth::parse_handedness(hand);
   if (!handedness) return fail("--hand must be right or left, got '" + hand + "'");
 
