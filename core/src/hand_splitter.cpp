@@ -232,7 +232,7 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
     fitted += share[static_cast<size_t>(s)] == FrameShare::kOwn ? 1 : 0;
   }
   // One hand to fit and nothing else sizeable in the working volume: the whole frame, so that one
-  // hand is tracked exactly as with max_hands 1 (masking the frame changes the median filter at the
+  // hand is tracked exactly as by a Tracker alone (masking the frame changes the median filter at the
   // hand's outline, and a tracker is chaotic enough for that to move whole sequences by mm).
   if (fitted == 1) {
     const auto only = static_cast<int>(std::find(share.begin(), share.end(), FrameShare::kOwn) - share.begin());

@@ -28,17 +28,11 @@ void HandsInputs::build(const DepthImage& depth, const HandsRequest& request, co
 }
 
 uint32_t HandsInputs::share(const DepthImage& depth, const HandsRequest& request) {
-  // One hand tracked: the whole frame, exactly as a Tracker alone sees it. Else the splitter shares
-  // it out; for one free slot too, so that a surface found to be no hand (a body's fragment nearer
-  // than the hand) is not taken again and again (HandsRequest::rejected).
-  split_ = request.max_hands > 1 || !request.slots[0].active;
-  if (split_) {
-    splitter_->split(config_, depth, request, foreign_, share_, candidate_);
-  } else {
-    share_.fill(FrameShare::kNothing);
-    share_[0] = FrameShare::kWhole;
-    candidate_.fill(std::nullopt);
-  }
+  // The splitter shares the frame out for one hand too: a tracked hand gets its own surfaces when
+  // something else sizeable is in the volume (a body, its head), the whole frame when not (then
+  // exactly as a Tracker alone sees it), and a free slot is not given a surface found to be no hand
+  // again and again (HandsRequest::rejected).
+  splitter_->split(config_, depth, request, foreign_, share_, candidate_);
   uint32_t slots = 0;
   for (size_t s = 0; s < kMaxHands; ++s) {
     has_[s] = share_[s] != FrameShare::kNothing;
@@ -50,9 +44,9 @@ uint32_t HandsInputs::share(const DepthImage& depth, const HandsRequest& request
 void HandsInputs::build_slot(int slot, const DepthImage& depth, const HandsRequest& request,
                              const PixelLabeller* labeller) {
   const auto s = static_cast<size_t>(slot);
-  // The splitter's median filter, when it ran, is every slot's.
+  // The splitter's median filter is every slot's.
   inputs_[s].build(depth, request.slots[s].request, labeller, share_[s] == FrameShare::kWhole ? nullptr : &foreign_[s],
-                   split_ ? &splitter_->median() : nullptr);
+                   &splitter_->median());
 }
 
 HandsTracker::HandsTracker(const TrackerConfig& config)

@@ -18,6 +18,7 @@ using Eigen::Vector3d;
 // Random streams (Rng::stream purposes), so that changing one use never shifts another.
 constexpr uint64_t kSubjectStream = 0x5B1EC7;
 constexpr uint64_t kNoiseStream = 0x0015E;
+constexpr uint64_t kBodyStream = 0xB0D1;  // Background::kNearBody's build
 constexpr double kSubjectSpread = 0.10;  // random subjects: scales within +-10 % (module brief)
 // Two-hand scenes draw both hands into one z-buffer with hand k's solids labelled
 // part_label | (k + 1) << kHandTagShift, so that each pixel says which hand it shows; the tag is
@@ -236,15 +237,24 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
       break;
     case Background::kDesk:  // drawn with the hand, in every frame (desk_under)
       break;
-    case Background::kNearBody:
+    case Background::kNearBody: {
       // The torso as a capsule of radius 220 mm (rounded: no plane for the tracker's desk
-      // detection) whose top, seen in the lower half of the image, is 430-600 mm away; neck and a
-      // head of radius 75 mm (485-560 mm) above it: inside the tracker's 150-600 mm working volume,
-      // just behind the hand and touching its forearm.
-      background_solids.push_back(ConeSphere{{30, 330, 640}, {30, 900, 640}, 220.0, 220.0, kBackground});
-      background_solids.push_back(ConeSphere{{30, -100, 590}, {30, 110, 620}, 45.0, 45.0, kBackground});
-      background_solids.push_back(ConeSphere{{30, -170, 560}, {30, -170, 560}, 75.0, 75.0, kBackground});
+      // detection) whose top, seen in the lower half of the image, is about 430-600 mm away; neck
+      // and a head (radius 65-85 mm, about 485-560 mm away) above it: inside the tracker's 150-600
+      // mm working volume, just behind the hand and touching its forearm. The body's place and the
+      // head's size vary with the seed (its own stream: the subject and noise are as with the other
+      // backgrounds).
+      Rng rng = Rng::stream(s.options.seed, kBodyStream, 0);
+      const Vector3d at(rng.uniform(-60.0, 60.0), rng.uniform(-30.0, 30.0), rng.uniform(-30.0, 30.0));
+      const double head = rng.uniform(65.0, 85.0);
+      background_solids.push_back(
+          ConeSphere{at + Vector3d(30, 330, 640), at + Vector3d(30, 900, 640), 220.0, 220.0, kBackground});
+      background_solids.push_back(
+          ConeSphere{at + Vector3d(30, -100, 590), at + Vector3d(30, 110, 620), 45.0, 45.0, kBackground});
+      const Vector3d head_centre = at + Vector3d(30, -95 - head, 560);
+      background_solids.push_back(ConeSphere{head_centre, head_centre, head, head, kBackground});
       break;
+    }
     case Background::kTable:
       // A table top through (0, 250, 750) mm rising away from the camera (normal up and toward the
       // camera): at the bottom of the image ~610 mm, crossing the image centre at ~1 m.

@@ -343,6 +343,39 @@ TEST(PartForestTraining, FartherPosesAndWorkingVolumeGiveFartherHands) {
   EXPECT_GT(deepest_mask_pixel(850.0), 650.0F);
 }
 
+TEST(PartForestTraining, BodyImagesAreTheBodyWithoutTheHandAllBackground) {
+  // --body-fraction: an image is the body of a near-body scene (synth --background near-body) once
+  // the hand and its forearm are gone, labelled background; 0 leaves every scene as it was.
+  forest::SceneOptions o;
+  o.body_fraction = 1.0;
+  forest::SceneOptions none;
+  int body_images = 0;
+  int body_pixels = 0;
+  int hand_labelled = 0;
+  for (uint64_t i = 0; i < 30; ++i) {
+    const forest::Scene s = forest::make_scene(9, i, o);
+    const forest::Scene plain = forest::make_scene(9, i, none);
+    EXPECT_FALSE(plain.body);
+    EXPECT_EQ(s.options.seed, plain.options.seed);  // the body is drawn last: the rest is unchanged
+    EXPECT_EQ(s.pose.translation_mm, plain.pose.translation_mm);
+    if (!s.body) {
+      EXPECT_EQ(s.options.view, synth::View::kHeadMounted);  // a near body is for the desk camera's views
+      continue;
+    }
+    EXPECT_EQ(s.options.background, synth::Background::kNearBody);
+    DepthInputBuilder builder;
+    forest::RenderedScene r;
+    forest::render_scene(s, builder, r);
+    const forest::LabelledImage img = forest::crop_hand(r.input, r.frame.labels.pixels);
+    ++body_images;
+    body_pixels += img.hand_pixels;
+    for (const uint8_t l : img.labels) hand_labelled += l != 0 && l != forest::LabelledImage::kOffMask ? 1 : 0;
+  }
+  EXPECT_GT(body_images, 20);
+  EXPECT_GT(body_pixels, 1000 * body_images / 2);  // most images hold a head or the torso's rest
+  EXPECT_LT(hand_labelled, body_pixels / 100);     // at most the hand's edge flying into the body
+}
+
 TEST(SynthRenderPose, RenderingAMotionsPoseEqualsRenderingItsFrame) {
   synth::SynthOptions o;
   o.motion = "tigergrasp";

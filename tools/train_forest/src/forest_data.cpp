@@ -91,15 +91,34 @@ Scene make_scene(uint64_t seed, uint64_t index, const SceneOptions& options) {
   if (options.ball_fraction > 0.0 && rng.uniform() < options.ball_fraction) {
     s.options.ball_radius_mm = rng.uniform(kMinBallMm, kMaxBallMm);
   }
+  if (options.body_fraction > 0.0 && rng.uniform() < options.body_fraction &&
+      s.options.view != synth::View::kHeadMounted) {
+    s.body = true;
+    s.options.background = synth::Background::kNearBody;
+  }
   return s;
 }
 
 void render_scene(const Scene& scene, DepthInputBuilder& builder, RenderedScene& out) {
-  synth::SyntheticCamera cam(scene.options);
-  if (scene.from_motion) {
-    cam.render(scene.frame, out.frame);
-  } else {
-    cam.render_pose(scene.pose, scene.frame, out.frame);
+  const auto render = [&](const synth::SynthOptions& options, synth::SynthFrame& frame) {
+    synth::SyntheticCamera cam(options);
+    if (scene.from_motion) {
+      cam.render(scene.frame, frame);
+    } else {
+      cam.render_pose(scene.pose, scene.frame, frame);
+    }
+  };
+  render(scene.options, out.frame);
+  if (scene.body) {
+    // The hand and its forearm are where the same scene without a background has depth: gone, the
+    // rest is what a free slot would be given.
+    synth::SynthOptions alone = scene.options;
+    alone.background = synth::Background::kNone;
+    synth::SynthFrame hand;
+    render(alone, hand);
+    for (size_t i = 0; i < hand.depth.depth_mm.size(); ++i) {
+      if (hand.depth.depth_mm[i] > 0.0F) out.frame.depth.depth_mm[i] = 0.0F;
+    }
   }
   out.input = builder.build(out.frame.depth, std::nullopt);
 }

@@ -226,6 +226,10 @@ int main(int argc, char** argv) {
   app.add_option("--ball-fraction", scene.ball_fraction,
                  "Share of images with a ball held against the palm (radius 20-45 mm), its pixels background")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--body-fraction", scene.body_fraction,
+                 "Share of images of the body inside the working volume without the hand (a head, the rest of a "
+                 "torso: what a free hand slot would be given), all background")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--pose-far-mm", scene.far_mm, "Farthest palm depth of the random poses (from 250 mm)")
       ->check(CLI::Range(300.0, 1500.0))
       ->capture_default_str();
@@ -287,7 +291,8 @@ int main(int argc, char** argv) {
             << " --candidates " << train.candidates << " --thresholds " << train.thresholds_per_feature
             << " --min-leaf " << train.min_leaf_samples << " --motion-fraction " << scene.motion_fraction
             << " --turned-fraction " << scene.turned_fraction << " --view-fraction " << scene.view_fraction
-            << " --ball-fraction " << scene.ball_fraction << " --pose-far-mm " << scene.far_mm
+            << " --ball-fraction " << scene.ball_fraction << " --body-fraction " << scene.body_fraction
+            << " --pose-far-mm " << scene.far_mm
             << " --volume-far-mm " << scene.volume_far_mm << " --seed " << train.seed;
     const auto t1 = std::chrono::steady_clock::now();
     progress.restart();

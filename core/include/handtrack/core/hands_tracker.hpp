@@ -12,8 +12,7 @@
 //   3. A free slot takes the nearest unclaimed surface that could be a hand (big enough, not a
 //      body reaching in through the far plane, not the part of a body wider than any hand); a new
 //      hand therefore appears only apart from the hands already tracked, and one that touches a
-//      tracked hand waits until they part. With room for one hand, a free slot is given its
-//      surface so too (a surface found to be no hand is passed over); a tracked one the whole frame.
+//      tracked hand waits until they part. So too with room for one hand.
 //   4. Each slot's Tracker sees the frame with every pixel but its own marked foreign: never its
 //      hand, but still depth (a hand behind the other is hidden there, not floating over nothing),
 //      and fits it exactly as it fits a single hand.
@@ -69,7 +68,7 @@ class HandSplitter;  // core/src: steps 1-3 above
 enum class FrameShare : uint8_t {
   kNothing,  // a free slot with no new surface
   kWhole,    // the whole frame: the only hand to fit, and no other sizeable surface to tell apart
-             // (exactly what a Tracker alone sees: one hand is tracked as with max_hands 1)
+             // (exactly what a Tracker alone sees: the hand is tracked as by a Tracker alone)
   kOwn,      // its own pixels, the rest 0 (an active slot's maybe none)
 };
 
@@ -105,7 +104,6 @@ class HandsInputs {
   std::array<bool, kMaxHands> has_{};
   std::array<FrameShare, kMaxHands> share_{};
   std::array<std::optional<Eigen::Vector3d>, kMaxHands> candidate_{};
-  bool split_ = false;  // share() ran the splitter
 };
 
 // One frame's hands, in slot order (not sorted by id); count of them valid.

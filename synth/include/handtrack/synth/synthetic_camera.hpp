@@ -34,8 +34,9 @@ enum class Background {
   kBody,   // a torso plane 700-850 mm away (and a head), the forearm reaching toward it
   kTable,  // a plane tilted like a table top, below and behind the hand (>= ~600 mm in view)
   kDesk,   // a desk the forearm lies on and the hand rests on, in every frame (one-hand motions only)
-  kNearBody,  // a user close to the camera: a rounded torso (430-600 mm), neck and head (485-560
-              // mm) inside the working volume behind the hand
+  kNearBody,  // a user close to the camera: a rounded torso (about 430-600 mm), neck and head
+              // (about 485-560 mm; its size and the body's place vary with the seed) inside the
+              // working volume behind the hand
 };
 std::string_view background_name(Background background);
 std::optional<Background> parse_background(std::string_view name);

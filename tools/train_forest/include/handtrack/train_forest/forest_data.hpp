@@ -54,6 +54,12 @@ struct SceneOptions {
   // that the tracker can drop them (DepthInputConfig::drop_background). Drawn after everything else
   // in a scene, so 0 leaves the data set of the forests trained before it unchanged.
   double ball_fraction = 0.0;
+  // Share of the images that show what a free hand slot is given besides the hand when the body is
+  // inside the working volume (synth --background near-body, not with the head-mounted view): the
+  // surface segmentation takes once the hand and its forearm are gone (a head, the rest of a
+  // torso), all of it background (label 0) to learn, so that the tracker drops it instead of
+  // fitting a hand to it. Drawn last, so 0 leaves the data set unchanged.
+  double body_fraction = 0.0;
   CameraIntrinsics camera = synth::default_camera();
 };
 
@@ -62,6 +68,7 @@ struct Scene {
   bool from_motion = false;
   int frame = 0;
   synth::HandPose pose;  // what is rendered
+  bool body = false;     // SceneOptions::body_fraction: the body without the hand is segmented
 };
 
 // The scene of image `index` of the data set `seed` (deterministic).
