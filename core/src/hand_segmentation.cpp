@@ -137,7 +137,7 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
         ++kept;
       }
     }
-    return kept;
+    return keep_near_palm(config, cam, *segmented, centre, out.hand_mask, kept);
   };
   const auto area_mm2 = [&](int pixels, double depth_mm) { return surface_area_mm2(cam, pixels, depth_mm); };
 
@@ -252,6 +252,94 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
     std::fill(out.hand_mask.begin(), out.hand_mask.end(), 0);
     out.hand_pixels = 0;
   }
+}
+
+int HandSegmenter::keep_near_palm(const DepthInputConfig& config, const CameraIntrinsics& cam,
+                                  const std::vector<float>& depth, const Eigen::Vector3d& centre,
+                                  std::vector<uint8_t>& mask, int kept) {
+  // The mask's connected parts (neighbours closer than continuity_mm) that come within
+  // kNearPalmInLengths hand lengths of the palm centre are the hand: a part beyond, however near
+  // the hand's sphere it reaches, is something else (a head or a torso behind the hand, another
+  // object), which the sphere alone let in (docs/TRACKER.md, "A body in the working volume").
+  // Parts are marked 2 while flooded from the pixels near the palm; what stays 1 leaves the mask.
+  if (kept == 0) return 0;
+  const int w = cam.width;
+  const PixelBox box = hand_box_;
+  const double near2 = std::pow(kNearPalmInLengths * config.hand_length_mm, 2);
+  // As select() unprojects: p = (r_u d, r_v d, d).
+  const auto point = [&](int u, int v, float d) {
+    return Eigen::Vector3d(ray_u_[static_cast<size_t>(u)] * d, (v - cam.cy) / cam.fy * d, d);
+  };
+  stack_.reserve(mask.size());  // every pixel at most once: no allocation once a frame was seen
+  part_.reserve(mask.size());
+  stack_.clear();
+  for (int v = box.v0; v <= box.v1; ++v) {
+    for (int u = box.u0; u <= box.u1; ++u) {
+      const auto i = static_cast<size_t>(v) * w + u;
+      if (mask[i] != 1 || (point(u, v, depth[i]) - centre).squaredNorm() > near2) continue;
+      mask[i] = 2;
+      stack_.push_back(static_cast<int>(i));
+    }
+  }
+  while (!stack_.empty()) {
+    const auto i = static_cast<size_t>(stack_.back());
+    stack_.pop_back();
+    const int u = static_cast<int>(i % static_cast<size_t>(w));
+    const int v = static_cast<int>(i / static_cast<size_t>(w));
+    for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+      if (u + du < box.u0 || u + du > box.u1 || v + dv < box.v0 || v + dv > box.v1) continue;
+      const auto j = static_cast<size_t>(v + dv) * w + (u + du);
+      if (mask[j] != 1 || std::abs(depth[j] - depth[i]) >= config.continuity_mm) continue;
+      mask[j] = 2;
+      stack_.push_back(static_cast<int>(j));
+    }
+  }
+  // The parts not reached: each one leaves when it is sizeable (min_hand_area_mm2: a head, a
+  // torso), while specks of noise and flying pixels stay as they were (marked 3 once looked at).
+  int dropped = 0;
+  for (int v = box.v0; v <= box.v1; ++v) {
+    for (int u = box.u0; u <= box.u1; ++u) {
+      const auto seed = static_cast<size_t>(v) * w + u;
+      if (mask[seed] != 1) continue;
+      part_.clear();
+      stack_.assign(1, static_cast<int>(seed));
+      mask[seed] = 3;
+      double area = 0.0;
+      while (!stack_.empty()) {
+        const auto i = static_cast<size_t>(stack_.back());
+        stack_.pop_back();
+        part_.push_back(static_cast<int>(i));
+        area += surface_area_mm2(cam, 1, depth[i]);
+        const int pu = static_cast<int>(i % static_cast<size_t>(w));
+        const int pv = static_cast<int>(i / static_cast<size_t>(w));
+        for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+          if (pu + du < box.u0 || pu + du > box.u1 || pv + dv < box.v0 || pv + dv > box.v1) continue;
+          const auto j = static_cast<size_t>(pv + dv) * w + (pu + du);
+          if (mask[j] != 1 || std::abs(depth[j] - depth[i]) >= config.continuity_mm) continue;
+          mask[j] = 3;
+          stack_.push_back(static_cast<int>(j));
+        }
+      }
+      if (area < config.min_hand_area_mm2) continue;
+      for (const int i : part_) {
+        mask[static_cast<size_t>(i)] = 0;
+        hand_sum_ -= point(static_cast<int>(i % w), static_cast<int>(i / w), depth[static_cast<size_t>(i)]);
+      }
+      dropped += static_cast<int>(part_.size());
+    }
+  }
+  // Back to 1; the box shrinks to what stays (unchanged when nothing left).
+  PixelBox stays{w, cam.height, -1, -1};
+  for (int v = box.v0; v <= box.v1; ++v) {
+    for (int u = box.u0; u <= box.u1; ++u) {
+      const auto i = static_cast<size_t>(v) * w + u;
+      if (mask[i] == 0) continue;
+      mask[i] = 1;
+      stays.add(u, v);
+    }
+  }
+  if (dropped > 0) hand_box_ = stays;
+  return kept - dropped;
 }
 
 }  // namespace handtrack

@@ -27,11 +27,21 @@ class HandSegmenter {
   [[nodiscard]] const PixelBox& hand_box() const { return hand_box_; }
 
  private:
+  // A connected part of the selected pixels is the hand's only when it comes within this many hand
+  // lengths of the palm centre (a finger apart from the palm in depth does within about 0.3-0.4).
+  static constexpr double kNearPalmInLengths = 0.5;
+  // Takes out of `mask` (1 = selected; `kept` pixels, hand_box_ and hand_sum_ theirs) the sizeable
+  // connected parts that do not come within kNearPalmInLengths of `centre`; returns how many
+  // pixels remain.
+  int keep_near_palm(const DepthInputConfig& config, const CameraIntrinsics& cam, const std::vector<float>& depth,
+                     const Eigen::Vector3d& centre, std::vector<uint8_t>& mask, int kept);
+
   std::vector<int> component_;
   std::vector<Surface> blobs_;
   std::vector<float> own_mm_;  // the filtered depth without the foreign pixels, or a body's wide parts
   BodyEraser body_;
   std::vector<int> stack_;
+  std::vector<int> part_;  // keep_near_palm(): one part's pixels
   PixelBox hand_box_{0, 0, -1, -1};                     // the segmented hand's pixels
   Eigen::Vector3d hand_sum_ = Eigen::Vector3d::Zero();  // sum of their 3D points
   std::vector<double> ray_u_;                           // (u - c_x) / f_x per image column

@@ -357,6 +357,42 @@ TEST(DepthInput, AnArmJoinedToABodyIsFollowedToItsHand) {
   EXPECT_LT((in.palm_centre_mm - hand_centre).norm(), 40.0) << in.palm_centre_mm.transpose();
 }
 
+TEST(DepthInput, AHeadBehindATrackedHandIsNotInItsMask) {
+  // Tracking (a hint from the last pose): a head (a sphere of radius 80 mm, its front 100 mm behind
+  // the hand) shows above and beside the hand's fingers, within a hand length of the palm centre
+  // but nowhere within half of one, and apart from the hand in depth: not the hand.
+  const auto cam = camera(320, 240);
+  std::vector<uint8_t> part;
+  DepthImage img = hand_alone(cam);
+  body_scene(cam, -220.0, false, part);  // marks the hand's pixels (2)
+  const Eigen::Vector3d head(70.0, -110.0, 630.0);
+  int head_pixels = 0;
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      const auto i = static_cast<size_t>(v) * cam.width + u;
+      const Eigen::Vector3d ray((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1.0);
+      const double b = ray.dot(head);
+      const double disc = b * b - ray.squaredNorm() * (head.squaredNorm() - 80.0 * 80.0);
+      if (disc < 0.0) continue;
+      const double z = (b - std::sqrt(disc)) / ray.squaredNorm();
+      if (z >= img.depth_mm[i]) continue;  // the hand is in front
+      img.depth_mm[i] = static_cast<float>(z);
+      part[i] = 1;
+      ++head_pixels;
+    }
+  }
+  ASSERT_GT(head_pixels, 1000);
+  const Eigen::Vector3d palm = cam.unproject(cam.cx + 60, cam.cy - 10, 455.0);
+  const HandHint hint{palm, palm + Eigen::Vector3d(0.0, 50.0, 0.0), Eigen::Vector3d(0.0, -1.0, 0.0)};
+  DepthInputBuilder alone;
+  const std::vector<uint8_t> expected = alone.build(hand_alone(cam), hint).hand_mask;
+  DepthInputBuilder builder;
+  const auto& in = builder.build(img, hint);
+  ASSERT_TRUE(in.has_hand());
+  EXPECT_EQ(torso_pixels_and_hand_share(in.hand_mask, part).first, 0);  // no head pixel
+  EXPECT_TRUE(in.hand_mask == expected);
+}
+
 TEST(HandsInputs, ANewHandIsNotABody) {
   // With room for one or two hands and none tracked, a free slot's new surface is the hand, not the
   // nearer torso: its centroid and pixels are the hand's without the torso.
