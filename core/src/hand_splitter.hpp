@@ -5,7 +5,7 @@
 // could be a hand for each free slot. Private to core (HandsInputs); its scratch is reused from
 // frame to frame.
 #include "body_eraser.hpp"
-#include "hand_segmentation.hpp"
+#include "surfaces.hpp"
 #include "median_filter.hpp"
 #include "support_plane.hpp"
 
