@@ -258,10 +258,10 @@ int HandSegmenter::keep_near_palm(const DepthInputConfig& config, const CameraIn
                                   const std::vector<float>& depth, const Eigen::Vector3d& centre,
                                   std::vector<uint8_t>& mask, int kept) {
   // The mask's connected parts (neighbours closer than continuity_mm) that come within
-  // kNearPalmInLengths hand lengths of the palm centre are the hand: a part beyond, however near
-  // the hand's sphere it reaches, is something else (a head or a torso behind the hand, another
-  // object), which the sphere alone let in (docs/TRACKER.md, "A body in the working volume").
-  // Parts are marked 2 while flooded from the pixels near the palm; what stays 1 leaves the mask.
+  // kNearPalmInLengths hand lengths of the palm centre are the hand: a sizeable part beyond, however
+  // near the hand's sphere it reaches, is something else (a head or a torso behind the hand,
+  // another object), which the sphere alone let in (docs/TRACKER.md, "A body in the working
+  // volume"). The parts reached from the pixels near the palm are marked 2.
   if (kept == 0) return 0;
   const int w = cam.width;
   const PixelBox box = hand_box_;
@@ -272,6 +272,24 @@ int HandSegmenter::keep_near_palm(const DepthInputConfig& config, const CameraIn
   };
   stack_.reserve(mask.size());  // every pixel at most once: no allocation once a frame was seen
   part_.reserve(mask.size());
+  // Floods from the pixels on stack_ through their 4-neighbours in the box that are still 1 and
+  // continuous in depth, marking them `mark`; `visit` sees each pixel flooded.
+  const auto flood = [&](uint8_t mark, const auto& visit) {
+    while (!stack_.empty()) {
+      const auto i = static_cast<size_t>(stack_.back());
+      stack_.pop_back();
+      visit(i);
+      const int u = static_cast<int>(i % static_cast<size_t>(w));
+      const int v = static_cast<int>(i / static_cast<size_t>(w));
+      for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+        if (u + du < box.u0 || u + du > box.u1 || v + dv < box.v0 || v + dv > box.v1) continue;
+        const auto j = static_cast<size_t>(v + dv) * w + (u + du);
+        if (mask[j] != 1 || std::abs(depth[j] - depth[i]) >= config.continuity_mm) continue;
+        mask[j] = mark;
+        stack_.push_back(static_cast<int>(j));
+      }
+    }
+  };
   stack_.clear();
   for (int v = box.v0; v <= box.v1; ++v) {
     for (int u = box.u0; u <= box.u1; ++u) {
@@ -281,19 +299,7 @@ int HandSegmenter::keep_near_palm(const DepthInputConfig& config, const CameraIn
       stack_.push_back(static_cast<int>(i));
     }
   }
-  while (!stack_.empty()) {
-    const auto i = static_cast<size_t>(stack_.back());
-    stack_.pop_back();
-    const int u = static_cast<int>(i % static_cast<size_t>(w));
-    const int v = static_cast<int>(i / static_cast<size_t>(w));
-    for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
-      if (u + du < box.u0 || u + du > box.u1 || v + dv < box.v0 || v + dv > box.v1) continue;
-      const auto j = static_cast<size_t>(v + dv) * w + (u + du);
-      if (mask[j] != 1 || std::abs(depth[j] - depth[i]) >= config.continuity_mm) continue;
-      mask[j] = 2;
-      stack_.push_back(static_cast<int>(j));
-    }
-  }
+  flood(2, [](size_t) {});
   // The parts not reached: each one leaves when it is sizeable (min_hand_area_mm2: a head, a
   // torso), while specks of noise and flying pixels stay as they were (marked 3 once looked at).
   int dropped = 0;
@@ -305,21 +311,10 @@ int HandSegmenter::keep_near_palm(const DepthInputConfig& config, const CameraIn
       stack_.assign(1, static_cast<int>(seed));
       mask[seed] = 3;
       double area = 0.0;
-      while (!stack_.empty()) {
-        const auto i = static_cast<size_t>(stack_.back());
-        stack_.pop_back();
+      flood(3, [&](size_t i) {
         part_.push_back(static_cast<int>(i));
         area += surface_area_mm2(cam, 1, depth[i]);
-        const int pu = static_cast<int>(i % static_cast<size_t>(w));
-        const int pv = static_cast<int>(i / static_cast<size_t>(w));
-        for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
-          if (pu + du < box.u0 || pu + du > box.u1 || pv + dv < box.v0 || pv + dv > box.v1) continue;
-          const auto j = static_cast<size_t>(pv + dv) * w + (pu + du);
-          if (mask[j] != 1 || std::abs(depth[j] - depth[i]) >= config.continuity_mm) continue;
-          mask[j] = 3;
-          stack_.push_back(static_cast<int>(j));
-        }
-      }
+      });
       if (area < config.min_hand_area_mm2) continue;
       for (const int i : part_) {
         mask[static_cast<size_t>(i)] = 0;
