@@ -93,18 +93,13 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
   // pixels it kept. Two passes over the image, no per-pixel lists: nothing grows with the hand.
   const auto select = [&]() {
     std::fill(out.hand_mask.begin(), out.hand_mask.end(), 0);
-    // Unprojection by ray: p = (r_u d, r_v d, d) with r_u = (u - c_x) / f_x, r_v = (v - c_y) / f_y.
     ray_u_.resize(static_cast<size_t>(w));
     for (int u = 0; u < w; ++u) ray_u_[static_cast<size_t>(u)] = (u - cam.cx) / cam.fx;
-    const auto ray_v = [&](int v) { return (v - cam.cy) / cam.fy; };
-    const auto ray_point = [&](int u, double r_v, float depth) {
-      return Vector3d(ray_u_[static_cast<size_t>(u)] * depth, r_v * depth, depth);
-    };
     PixelBox near{w, h, -1, -1};
     double tip = -std::numeric_limits<double>::infinity();
     for (int v = 0; v < h; ++v) {
       const float* row = segmented->data() + static_cast<size_t>(v) * w;
-      const double r_v = ray_v(v);
+      const double r_v = ray_v_of(cam, v);
       for (int u = 0; u < w; ++u) {
         if (u % kScanChunk == 0 && u + kScanChunk <= w && nothing_in(row + u)) {
           u += kScanChunk - 1;  // most of the image is outside the working volume
@@ -123,7 +118,7 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
     hand_sum_ = Vector3d::Zero();
     int kept = 0;
     for (int v = near.v0; v <= near.v1; ++v) {
-      const double r_v = ray_v(v);
+      const double r_v = ray_v_of(cam, v);
       for (int u = near.u0; u <= near.u1; ++u) {
         const auto i = static_cast<size_t>(v) * w + u;
         if (!out.hand_mask[i]) continue;
@@ -266,10 +261,7 @@ int HandSegmenter::keep_near_palm(const DepthInputConfig& config, const CameraIn
   const int w = cam.width;
   const PixelBox box = hand_box_;
   const double near2 = std::pow(kNearPalmInLengths * config.hand_length_mm, 2);
-  // As select() unprojects: p = (r_u d, r_v d, d).
-  const auto point = [&](int u, int v, float d) {
-    return Eigen::Vector3d(ray_u_[static_cast<size_t>(u)] * d, (v - cam.cy) / cam.fy * d, d);
-  };
+  const auto point = [&](int u, int v, float d) { return ray_point(u, ray_v_of(cam, v), d); };
   stack_.reserve(mask.size());  // every pixel at most once: no allocation once a frame was seen
   part_.reserve(mask.size());
   // Floods from the pixels on stack_ through their 4-neighbours in the box that are still 1 and

@@ -45,6 +45,11 @@ class HandSegmenter {
   PixelBox hand_box_{0, 0, -1, -1};                     // the segmented hand's pixels
   Eigen::Vector3d hand_sum_ = Eigen::Vector3d::Zero();  // sum of their 3D points
   std::vector<double> ray_u_;                           // (u - c_x) / f_x per image column
+  // Unprojection by ray (as segment() sets ray_u_): p = (r_u d, r_v d, d), r_v = (v - c_y) / f_y.
+  static double ray_v_of(const CameraIntrinsics& cam, int v) { return (v - cam.cy) / cam.fy; }
+  [[nodiscard]] Eigen::Vector3d ray_point(int u, double r_v, float depth) const {
+    return {ray_u_[static_cast<size_t>(u)] * depth, r_v * depth, depth};
+  }
 };
 
 }  // namespace handtrack

@@ -68,7 +68,7 @@ class HandSplitter;  // core/src: steps 1-3 above
 enum class FrameShare : uint8_t {
   kNothing,  // a free slot with no new surface
   kWhole,    // the whole frame: the only hand to fit, and no other sizeable surface to tell apart
-             // (exactly what a Tracker alone sees: the hand is tracked as by a Tracker alone)
+             // (exactly what a Tracker alone sees, so the hand is tracked as by one)
   kOwn,      // its own pixels, the rest 0 (an active slot's maybe none)
 };
 
