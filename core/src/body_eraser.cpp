@@ -109,22 +109,21 @@ void BodyEraser::add_opening(const CameraIntrinsics& camera, double radius_mm, c
   for (size_t seed = 0; seed < cells; ++seed) {
     if (mine[seed] != 1 || grid_[seed] <= 0) continue;
     part_.clear();
-    stack_.assign(1, seed);
+    stack_.assign(1, static_cast<int>(seed));
     mine[seed] = 2;  // visited
     double reach_mm = 0.0;
-    while (!stack_.empty()) {
-      const size_t k = stack_.back();
-      stack_.pop_back();
-      const auto i = static_cast<size_t>(pixel_[k]);
-      part_.push_back(i);
-      reach_mm = std::max(reach_mm, grid_[k] / 3.0 * depth_mm[i] / camera.focal());
-      // Surface cells are never on the grid's ring: their 4-neighbours are cells of the grid.
-      for (const size_t j : {k - 1, k + 1, k - static_cast<size_t>(gw), k + static_cast<size_t>(gw)}) {
-        if (mine[j] != 1 || grid_[j] <= 0) continue;
-        mine[j] = 2;
-        stack_.push_back(j);
-      }
-    }
+    flood4(
+        PixelBox{0, 0, gw - 1, gh - 1}, gw, stack_,
+        [&](size_t j, size_t) {
+          if (mine[j] != 1 || grid_[j] <= 0) return false;
+          mine[j] = 2;
+          return true;
+        },
+        [&](size_t k) {
+          const auto i = static_cast<size_t>(pixel_[k]);
+          part_.push_back(i);
+          reach_mm = std::max(reach_mm, grid_[k] / 3.0 * depth_mm[i] / camera.focal());
+        });
     if (reach_mm < radius_mm) opening_.insert(opening_.end(), part_.begin(), part_.end());
   }
 }

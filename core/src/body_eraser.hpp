@@ -59,7 +59,7 @@ class BodyEraser {
   std::vector<uint8_t> mine_;       // per grid cell: the surface's own
   std::vector<size_t> opening_;     // the openings' pixels (image indices)
   std::vector<size_t> part_;        // a part left of a surface (image indices)
-  std::vector<size_t> stack_;       // its flood fill (grid cells)
+  std::vector<int> stack_;          // its flood fill (grid cells)
 };
 
 }  // namespace handtrack

@@ -47,26 +47,18 @@ void drop_background_regions(DepthInput& input, const PixelBox& box, double min_
     stack.assign(1, static_cast<int32_t>(seed));
     input.hand_mask[seed] = 2;
     double area = 0.0;
-    while (!stack.empty()) {
-      const auto i = static_cast<size_t>(stack.back());
-      stack.pop_back();
-      region.push_back(static_cast<int32_t>(i));
-      const double z = input.filtered_mm[i];
-      area += z * z * pixel_area;
-      const int u = static_cast<int>(i % static_cast<size_t>(w));
-      const int v = static_cast<int>(i / static_cast<size_t>(w));
-      const auto visit = [&](int uu, int vv) {
-        if (uu < 0 || vv < 0 || uu >= w || vv >= h) return;
-        const size_t j = static_cast<size_t>(vv) * w + uu;
-        if (!background(j)) return;
-        input.hand_mask[j] = 2;
-        stack.push_back(static_cast<int32_t>(j));
-      };
-      visit(u - 1, v);
-      visit(u + 1, v);
-      visit(u, v - 1);
-      visit(u, v + 1);
-    }
+    flood4(
+        PixelBox{0, 0, w - 1, h - 1}, w, stack,
+        [&](size_t j, size_t) {
+          if (!background(j)) return false;
+          input.hand_mask[j] = 2;
+          return true;
+        },
+        [&](size_t i) {
+          region.push_back(static_cast<int32_t>(i));
+          const double z = input.filtered_mm[i];
+          area += z * z * pixel_area;
+        });
     const bool drop = area >= min_area_mm2;
     for (const int32_t i : region) input.hand_mask[static_cast<size_t>(i)] = drop ? 0 : 3;
     if (drop) input.hand_pixels -= static_cast<int>(region.size());

@@ -267,20 +267,14 @@ int HandSegmenter::keep_near_palm(const DepthInputConfig& config, const CameraIn
   // Floods from the pixels on stack_ through their 4-neighbours in the box that are still 1 and
   // continuous in depth, marking them `mark`; `visit` sees each pixel flooded.
   const auto flood = [&](uint8_t mark, const auto& visit) {
-    while (!stack_.empty()) {
-      const auto i = static_cast<size_t>(stack_.back());
-      stack_.pop_back();
-      visit(i);
-      const int u = static_cast<int>(i % static_cast<size_t>(w));
-      const int v = static_cast<int>(i / static_cast<size_t>(w));
-      for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
-        if (u + du < box.u0 || u + du > box.u1 || v + dv < box.v0 || v + dv > box.v1) continue;
-        const auto j = static_cast<size_t>(v + dv) * w + (u + du);
-        if (mask[j] != 1 || std::abs(depth[j] - depth[i]) >= config.continuity_mm) continue;
-        mask[j] = mark;
-        stack_.push_back(static_cast<int>(j));
-      }
-    }
+    flood4(
+        box, w, stack_,
+        [&](size_t j, size_t i) {
+          if (mask[j] != 1 || std::abs(depth[j] - depth[i]) >= config.continuity_mm) return false;
+          mask[j] = mark;
+          return true;
+        },
+        visit);
   };
   stack_.clear();
   for (int v = box.v0; v <= box.v1; ++v) {

@@ -13,28 +13,19 @@ void label_surfaces(const DepthInputConfig& config, const std::vector<float>& d,
     if (d[seed] <= 0.0F || component[seed] >= 0) continue;
     const int id = static_cast<int>(surfaces.size());
     Surface surface;
-    stack.clear();
-    stack.push_back(static_cast<int>(seed));
+    stack.assign(1, static_cast<int>(seed));
     component[seed] = id;
-    while (!stack.empty()) {
-      const auto i = static_cast<size_t>(stack.back());
-      stack.pop_back();
-      ++surface.pixels;
-      surface.depth_sum += d[i];
-      const int u = static_cast<int>(i % w);
-      const int v = static_cast<int>(i / w);
-      const auto visit = [&](int uu, int vv) {
-        if (uu < 0 || vv < 0 || uu >= w || vv >= h) return;
-        const auto j = static_cast<size_t>(vv) * w + uu;
-        if (component[j] >= 0 || d[j] <= 0.0F || std::abs(d[j] - d[i]) >= config.continuity_mm) return;
-        component[j] = id;
-        stack.push_back(static_cast<int>(j));
-      };
-      visit(u - 1, v);
-      visit(u + 1, v);
-      visit(u, v - 1);
-      visit(u, v + 1);
-    }
+    flood4(
+        PixelBox{0, 0, w - 1, h - 1}, w, stack,
+        [&](size_t j, size_t i) {
+          if (component[j] >= 0 || d[j] <= 0.0F || std::abs(d[j] - d[i]) >= config.continuity_mm) return false;
+          component[j] = id;
+          return true;
+        },
+        [&](size_t i) {
+          ++surface.pixels;
+          surface.depth_sum += d[i];
+        });
     surfaces.push_back(surface);
   }
 }

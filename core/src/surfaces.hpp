@@ -24,6 +24,27 @@ struct PixelBox {
   }
 };
 
+// The 4-connected flood fill of the segmentation's region steps (label_surfaces, a held object's
+// regions, a tracked hand's far parts, the body eraser's outline parts). Floods the cells of `box`
+// in a grid `w` cells wide from the cells on `stack`, each marked by the caller: a 4-neighbour j of
+// a flooded cell i joins when `enter(j, i)` holds (enter marks it, so no cell joins twice), and
+// `visit(i)` sees each flooded cell once. `stack` is scratch: empty afterwards.
+template <typename Enter, typename Visit>
+void flood4(const PixelBox& box, int w, std::vector<int>& stack, const Enter& enter, const Visit& visit) {
+  const auto step = static_cast<size_t>(w);
+  while (!stack.empty()) {
+    const auto i = static_cast<size_t>(stack.back());
+    stack.pop_back();
+    visit(i);
+    const int u = static_cast<int>(i % step);
+    const int v = static_cast<int>(i / step);
+    if (u > box.u0 && enter(i - 1, i)) stack.push_back(static_cast<int>(i - 1));
+    if (u < box.u1 && enter(i + 1, i)) stack.push_back(static_cast<int>(i + 1));
+    if (v > box.v0 && enter(i - step, i)) stack.push_back(static_cast<int>(i - step));
+    if (v < box.v1 && enter(i + step, i)) stack.push_back(static_cast<int>(i + step));
+  }
+}
+
 // A connected surface of the working volume: 4-neighbours whose depths differ less than
 // DepthInputConfig::continuity_mm.
 struct Surface {
