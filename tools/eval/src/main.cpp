@@ -1,9 +1,10 @@
 // handtrack-eval: track sequence directories and score them against their ground truth with the
 // paper's metrics (Sec. 7). SPEC.md "Evaluation output".
 //
-// A sequence whose hand.json names two hands is tracked with HandsTracker and scored per hand
-// (eval::HandsScorer, docs/SEQUENCES.md); a one-hand sequence with the one-hand Tracker, unless
-// --max-hands 2 asks for HandsTracker there too (a second hand it reports is a phantom).
+// Every sequence is tracked as handtrackd tracks, with HandsTracker (the frame shared out among
+// hand slots, docs/TRACKER.md "Two hands"). A sequence whose hand.json names two hands is scored
+// per hand (eval::HandsScorer, docs/SEQUENCES.md); a one-hand sequence with room for one hand,
+// unless --max-hands 2 asks for room for two there too (a second hand reported is a phantom).
 #include "handtrack/core/hand_calibration.hpp"
 #include "handtrack/core/hands_tracker.hpp"
 #include "handtrack/core/part_forest.hpp"
@@ -127,14 +128,21 @@ struct FrameLoop {
   [[nodiscard]] bool writes_tips() const { return tips != nullptr && tips->is_open(); }
 };
 
-// One hand (SPEC.md): Tracker, scored by SequenceScorer.
-eval::SequenceScore evaluate_one_hand(const SequenceReader& reader, const SequenceInfo& info,
-                                      const TrackerConfig& config, FrameLoop& loop) {
-  Tracker tracker(config);
+// One hand (SPEC.md): HandsTracker with room for one, scored by SequenceScorer.
+eval::SequenceScore evaluate_one_hand(const SequenceReader& reader, const SequenceInfo& info, TrackerConfig config,
+                                      FrameLoop& loop) {
+  config.max_hands = 1;
+  HandsTracker tracker(config);
   const std::string name = sequence_name(reader.dir());
   eval::SequenceScorer scorer(name, info.hands.front());
+  const auto track = [&](const DepthImage& depth) {
+    const HandsOutput out = tracker.track(depth, loop.labeller);
+    TrackerOutput none;
+    none.state = TrackingState::kNoHand;
+    return out.count > 0 ? out.hands[0] : none;
+  };
   const double seconds = loop.run(
-      reader, [&](const DepthImage& depth) { return tracker.track(depth, loop.labeller); },
+      reader, track,
       [&](size_t i, const TrackerOutput& out) {
         scorer.add(out, reader.fingertips(i));
         if (loop.writes_tips()) {
@@ -220,9 +228,8 @@ int main(int argc, char** argv) {
   app.add_flag("--sim-only", sim_only, "E_sim only: drop E_col, E_lim and E_smo (ablation of Fig. 6)");
   int max_hands = kMaxHands;
   app.add_option("--max-hands", max_hands,
-                 "hands HandsTracker may report (default 2); a sequence whose hand.json names two hands is always "
-                 "tracked with HandsTracker, a one-hand sequence only when this is given and > 1 (a second hand "
-                 "reported there is a phantom)")
+                 "hands HandsTracker may report (default 2, as handtrackd); a one-hand sequence is tracked with "
+                 "room for one hand unless this is given (a second hand reported there is a phantom)")
       ->check(CLI::Range(1, kMaxHands));
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
   if (energy == "late-fusion" && forest_file.empty() && !oracle_labels) {
