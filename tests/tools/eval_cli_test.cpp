@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -179,6 +180,31 @@ TEST_F(EvalCli, ATwoHandSequenceIsScoredPerHandAndAOneHandOneOnlyWhenAsked) {
   EXPECT_EQ(one.at("frames_without_pose"), 4);
   EXPECT_EQ(eval(&err, pair + " --max-hands 3"), 1);
   EXPECT_NE(err.find("--max-hands"), std::string::npos) << err;
+}
+
+// The working volume is the user's to set: a hand beyond --far-mm is not seen, and an empty volume
+// is refused with one line.
+TEST_F(EvalCli, TheWorkingVolumeIsTheUsers) {
+  handtrack::synth::SynthOptions o;
+  o.motion = "pinch";
+  o.frames = 4;
+  handtrack::synth::SyntheticCamera cam(o);
+  {
+    handtrack::SequenceWriter writer(dir_ / "pinch", cam.camera());
+    for (int f = 0; f < o.frames; ++f) {
+      const auto frame = cam.render(f);
+      writer.write_depth(f, frame.depth);
+      writer.write_fingertips(f, frame.fingertips);
+    }
+  }
+  const std::string pinch = "'" + (dir_ / "pinch").string() + "'";
+  std::string err;
+  EXPECT_EQ(eval(&err, pinch + " --energy depth-only"), 0) << err;
+  EXPECT_EQ(eval(&err, pinch + " --energy depth-only --far-mm 200"), 1);
+  EXPECT_NE(err.find("no frame could be scored"), std::string::npos) << err;
+  EXPECT_EQ(eval(&err, pinch + " --near-mm 500 --far-mm 400"), 1);
+  EXPECT_NE(err.find("handtrack-eval: error: --far-mm must be greater than --near-mm"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
 }
 
 // A one-hand sequence is tracked as handtrackd tracks it: by a HandsTracker with room for one hand

@@ -231,7 +231,15 @@ int main(int argc, char** argv) {
                  "hands HandsTracker may report (default 2, as handtrackd); a one-hand sequence is tracked with "
                  "room for one hand unless this is given (a second hand reported there is a phantom)")
       ->check(CLI::Range(1, kMaxHands));
+  app.add_option("--near-mm", config.input.near_mm, "near end of the working volume, mm (default 150, the paper's)")
+      ->check(CLI::Range(1.0, 20000.0));
+  app.add_option("--far-mm", config.input.far_mm,
+                 "far end of the working volume, mm (default 600, the paper's; hands farther away are not seen)")
+      ->check(CLI::Range(1.0, 20000.0));
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
+  if (config.input.far_mm <= config.input.near_mm) {
+    return report_error(kProgram, "--far-mm must be greater than --near-mm", 1);
+  }
   if (energy == "late-fusion" && forest_file.empty() && !oracle_labels) {
     const auto shipped = shipped_forest_path();
     if (!shipped) {
