@@ -61,6 +61,19 @@ class EvalCli : public ::testing::Test {
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   }
 
+  // Renders a one-hand synthetic sequence with ground-truth fingertips into dir_ / name.
+  fs::path render(const std::string& name, const handtrack::synth::SynthOptions& options) const {
+    handtrack::synth::SyntheticCamera cam(options);
+    handtrack::SequenceWriter writer(dir_ / name, cam.camera());
+    for (int f = 0; f < options.frames; ++f) {
+      const auto frame = cam.render(f);
+      writer.write_depth(f, frame.depth);
+      writer.write_fingertips(f, frame.fingertips);
+    }
+    writer.flush();
+    return dir_ / name;
+  }
+
   fs::path dir_;
 };
 
@@ -92,15 +105,7 @@ TEST_F(EvalCli, GroupsSequencesByTheViewMotionAndHandTheirHandJsonNames) {
     handtrack::synth::SynthOptions o;
     o.motion = motion;
     o.frames = 6;
-    handtrack::synth::SyntheticCamera cam(o);
-    handtrack::SequenceWriter writer(dir_ / motion, cam.camera());
-    for (int f = 0; f < o.frames; ++f) {
-      const auto frame = cam.render(f);
-      writer.write_depth(f, frame.depth);
-      writer.write_fingertips(f, frame.fingertips);
-    }
-    writer.flush();
-    describe(dir_ / motion, "right", "palm", motion);
+    describe(render(motion, o), "right", "palm", motion);
   }
   describe(dir_ / "seq", "left", "head-mounted", "pinch");
   const fs::path json = dir_ / "eval.json";
@@ -188,16 +193,7 @@ TEST_F(EvalCli, TheWorkingVolumeIsTheUsers) {
   handtrack::synth::SynthOptions o;
   o.motion = "pinch";
   o.frames = 4;
-  handtrack::synth::SyntheticCamera cam(o);
-  {
-    handtrack::SequenceWriter writer(dir_ / "pinch", cam.camera());
-    for (int f = 0; f < o.frames; ++f) {
-      const auto frame = cam.render(f);
-      writer.write_depth(f, frame.depth);
-      writer.write_fingertips(f, frame.fingertips);
-    }
-  }
-  const std::string pinch = "'" + (dir_ / "pinch").string() + "'";
+  const std::string pinch = "'" + render("pinch", o).string() + "'";
   std::string err;
   EXPECT_EQ(eval(&err, pinch + " --energy depth-only"), 0) << err;
   EXPECT_EQ(eval(&err, pinch + " --energy depth-only --far-mm 200"), 1);
@@ -220,18 +216,10 @@ TEST_F(EvalCli, AOneHandSequenceIsTrackedAsHandtrackdTracksIt) {
   o.frames = 30;
   o.seed = 3;
   o.background = handtrack::synth::Background::kNearBody;
-  handtrack::synth::SyntheticCamera cam(o);
-  {
-    handtrack::SequenceWriter writer(dir_ / "near", cam.camera());
-    for (int f = 0; f < o.frames; ++f) {
-      const auto frame = cam.render(f);
-      writer.write_depth(f, frame.depth);
-      writer.write_fingertips(f, frame.fingertips);
-    }
-  }
+  const fs::path near = render("near", o);
   const fs::path tips = dir_ / "tips.csv";
   std::string err;
-  ASSERT_EQ(eval(&err, "'" + (dir_ / "near").string() + "' --tips-csv '" + tips.string() + "'"), 0) << err;
+  ASSERT_EQ(eval(&err, "'" + near.string() + "' --tips-csv '" + tips.string() + "'"), 0) << err;
   std::ifstream in(tips);
   std::string line;
   std::getline(in, line);  // header
@@ -248,7 +236,7 @@ TEST_F(EvalCli, AOneHandSequenceIsTrackedAsHandtrackdTracksIt) {
   ASSERT_EQ(rows.size(), 30U);
 
   const handtrack::PartForest forest = handtrack::PartForest::load(*forest_path);
-  const handtrack::SequenceReader reader(dir_ / "near");
+  const handtrack::SequenceReader reader(near);
   handtrack::TrackerConfig config;  // handtrack-eval's defaults: late fusion, the shipped forest
   config.mode = handtrack::EnergyMode::kLateFusion;
   config.max_hands = 1;
