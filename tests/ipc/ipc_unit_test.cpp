@@ -253,18 +253,21 @@ TEST(IpcWait, WakesWhenAnotherThreadPublishes) {
   PoseRingWriter writer(options_for(name));
   PoseRingReader reader;
   ASSERT_EQ(reader.open(name.value), HANDTRACK_OK);
+  // The clock starts before the publisher does: it publishes no sooner than 50 ms after t0, so a
+  // reader that waited for it waited at least that long (started after the thread, t0 could come
+  // late by however long this thread was descheduled: 44.95 ms once).
+  const auto t0 = std::chrono::steady_clock::now();
   std::thread publisher([&] {
     std::this_thread::sleep_for(50ms);
     writer.publish(make_test_record(9));
   });
   FrameRecord out{};
-  const auto t0 = std::chrono::steady_clock::now();
   const Status status = reader.wait_next(out, 5s);
   const double waited = seconds_since(t0);
   publisher.join();
   ASSERT_EQ(status, HANDTRACK_OK);
   EXPECT_EQ(out.frame, 9U);
-  EXPECT_GE(waited, 0.045);
+  EXPECT_GE(waited, 0.050);
   EXPECT_LT(waited, 1.0);  // woken by the futex, not by the 5 s timeout
 }
 
