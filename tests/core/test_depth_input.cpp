@@ -256,6 +256,15 @@ TEST(DepthInput, AFlatHandIsNotADesk) {
 // joins the torso to the hand, its depth running from one to the other: torso, arm and hand are one
 // surface. Marks each pixel as torso (1) or hand (2; its forearm not) in `part`.
 // hand_alone() is the same scene without the torso (and the arm): what the hand is without them.
+// The depth where the ray through pixel (u, v) first meets the sphere of `radius` mm about `centre`
+// (camera frame), or 0 where it misses.
+double sphere_depth(const CameraIntrinsics& cam, double u, double v, const Eigen::Vector3d& centre, double radius) {
+  const Eigen::Vector3d ray((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1.0);  // p = z ray
+  const double b = ray.dot(centre);
+  const double disc = b * b - ray.squaredNorm() * (centre.squaredNorm() - radius * radius);
+  return disc < 0.0 ? 0.0 : (b - std::sqrt(disc)) / ray.squaredNorm();
+}
+
 DepthImage body_scene(const CameraIntrinsics& cam, double torso_x_mm, bool arm, std::vector<uint8_t>& part) {
   const auto n = static_cast<size_t>(cam.width) * cam.height;
   DepthImage img{cam, std::vector<float>(n, 800.0F)};
@@ -269,10 +278,7 @@ DepthImage body_scene(const CameraIntrinsics& cam, double torso_x_mm, bool arm, 
   // Where the ray through pixel (u, v) meets the sphere (the nearer root), if less than 60 mm
   // deeper than its front; else 0.
   const auto torso_depth = [&](double u, double v) {
-    const Eigen::Vector3d ray((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1.0);  // p = z ray
-    const double b = ray.dot(centre);
-    const double disc = b * b - ray.squaredNorm() * (centre.squaredNorm() - kRadius * kRadius);
-    const double z = disc < 0.0 ? 0.0 : (b - std::sqrt(disc)) / ray.squaredNorm();
+    const double z = sphere_depth(cam, u, v, centre, kRadius);
     return z < front + 60.0 ? z : 0.0;
   };
   // Where the torso ends on the arm's middle row: the arm leaves it there.
@@ -370,12 +376,8 @@ TEST(DepthInput, AHeadBehindATrackedHandIsNotInItsMask) {
   for (int v = 0; v < cam.height; ++v) {
     for (int u = 0; u < cam.width; ++u) {
       const auto i = static_cast<size_t>(v) * cam.width + u;
-      const Eigen::Vector3d ray((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1.0);
-      const double b = ray.dot(head);
-      const double disc = b * b - ray.squaredNorm() * (head.squaredNorm() - 80.0 * 80.0);
-      if (disc < 0.0) continue;
-      const double z = (b - std::sqrt(disc)) / ray.squaredNorm();
-      if (z >= img.depth_mm[i]) continue;  // the hand is in front
+      const double z = sphere_depth(cam, u, v, head, 80.0);
+      if (z <= 0.0 || z >= img.depth_mm[i]) continue;  // a miss, or the hand is in front
       img.depth_mm[i] = static_cast<float>(z);
       part[i] = 1;
       ++head_pixels;
