@@ -713,6 +713,9 @@ void PoseTracker::watch_confidence(double conf, CheckOutcome check) {
   // (re)start that is better than the wrong pose but still poor is checked again; a check that
   // keeps the tracked pose accepts its confidence as the level, so a pose that merely explains
   // less (a hand turned sideways) is not checked again and again.
+  //
+  // A wrong pose that never fell (a (re)start that chose it) is only found by looking again: a
+  // level below recheck_below_confidence is rechecked every recheck_interval_frames frames.
   const bool first = confidence_level_ <= 0.0;
   const bool suspect = !first && conf < config_.suspect_confidence_ratio * confidence_level_;
   if (first || check == CheckOutcome::kTrackedKept) {
@@ -721,7 +724,9 @@ void PoseTracker::watch_confidence(double conf, CheckOutcome check) {
     confidence_level_ += config_.confidence_level_rate * (conf - confidence_level_);
   }
   frames_since_check_ = check == CheckOutcome::kNone ? frames_since_check_ + 1 : 0;
-  check_next_ = suspect && !check_.active && frames_since_check_ >= config_.check_interval_frames;
+  const bool recheck = config_.recheck_interval_frames > 0 && frames_since_check_ >= config_.recheck_interval_frames &&
+                       confidence_level_ < config_.recheck_below_confidence;
+  check_next_ = (suspect || recheck) && !check_.active && frames_since_check_ >= config_.check_interval_frames;
 }
 
 bool PoseTracker::fuses(const DepthInput& input) const {

@@ -141,6 +141,14 @@ const std::vector<Field>& fields() {
      0.001, 1, "rate of the running confidence level (exponential average)", true},
     {"tracker.check_interval_frames", IntRef{[](DaemonConfig& c) -> int& { return c.tracker.check_interval_frames; }}, 1,
      1000, "at most one such check per this many frames", true},
+    {"tracker.recheck_interval_frames",
+     IntRef{[](DaemonConfig& c) -> int& { return c.tracker.recheck_interval_frames; }}, 0, 100000,
+     "a fit whose running confidence stays below recheck_below_confidence is checked the same way every this many "
+     "frames (0: never)",
+     true},
+    {"tracker.recheck_below_confidence",
+     DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.recheck_below_confidence; }}, 0, 1,
+     "running confidence below which a fit is rechecked every recheck_interval_frames", true},
     {"tracker.check_iterations_per_frame",
      IntRef{[](DaemonConfig& c) -> int& { return c.tracker.check_iterations_per_frame; }}, 0, 1000,
      "0: a check is made on one frame (10-16 ms); N: spread over frames, about N iterations each (64: every frame "

@@ -106,6 +106,38 @@ TEST(TrackingRecovery, BackWithin30FramesAfterAGrossError) {
   }
 }
 
+// Rechecks of a mediocre fit (TrackerConfig::recheck_interval_frames, off by default; here every
+// 30 frames below a confidence of 0.8): a wrong pose whose
+// confidence never fell past the suspect ratio is still checked while it explains little of the
+// hand. With the suspect check off, the knocks above are found only by the rechecks (and the lost
+// rule): every knock back within 30 frames. The same knocks without rechecks show the scenario
+// needs them: then some knock is not back (the lost rule alone: docs/TRACKER.md, "Recovery").
+// Measured: with rechecks 6 of 6 back after 2-3 frames, without 2 of 6. (flexex1 is left out: a
+// check shortly before its knock at frame 60 made the recheck wait 24 frames, by design up to 30.)
+TEST(TrackingRecovery, AMediocreFitIsRecheckedThoughItsConfidenceNeverFell) {
+  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  TrackerConfig config = testing::paper_config(EnergyMode::kLateFusion);
+  config.suspect_confidence_ratio = 0.0;
+  config.recheck_interval_frames = 30;
+  TrackerConfig without = config;
+  without.recheck_interval_frames = 0;
+  int back_without = 0;
+  int knocks = 0;
+  for (const auto motion : {"fingerwave", "tigergrasp"}) {
+    std::mt19937_64 rng(6);
+    std::mt19937_64 same_rng(6);
+    const auto recovered = knock_off_and_track(motion, config, forest, rng);
+    const auto recovered_without = knock_off_and_track(motion, without, forest, same_rng);
+    for (size_t n = 0; n < recovered.size(); ++n) {
+      EXPECT_GE(recovered[n], 1) << motion << " knocked off after frame " << kKnockFrames[n]
+                                 << " is not back within 30 frames with rechecks";
+      back_without += recovered_without[n] >= 1 ? 1 : 0;
+      ++knocks;
+    }
+  }
+  EXPECT_LT(back_without, knocks) << "every knock is back without rechecks: the scenario no longer needs them";
+}
+
 // Checks spread over frames (TrackerConfig::check_iterations_per_frame, the latency setting): a
 // frame that follows a tracked frame runs tracking's particles and at most about
 // check_iterations_per_frame more, never a whole (re)start search; only a frame with no pose to go
