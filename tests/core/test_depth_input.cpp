@@ -249,13 +249,6 @@ TEST(DepthInput, AFlatHandIsNotADesk) {
   EXPECT_EQ(builder.build(img, std::nullopt).hand_pixels, expected);
 }
 
-// A user close to the camera (body_eraser.hpp): the torso, rounded (a sphere of radius 200 mm
-// centred at (torso_x_mm, 0, 540 mm): its front 340 mm away), seen where it is less than
-// 60 mm deeper than its front; the hand, an elliptic bump (about 55 x 80 mm) at 450 mm right of the
-// image centre, with its forearm down to the bottom edge; beyond both, 800 mm. With `arm`, a band
-// joins the torso to the hand, its depth running from one to the other: torso, arm and hand are one
-// surface. Marks each pixel as torso (1) or hand (2; its forearm not) in `part`.
-// hand_alone() is the same scene without the torso (and the arm): what the hand is without them.
 // The depth where the ray through pixel (u, v) first meets the sphere of `radius` mm about `centre`
 // (camera frame), or 0 where it misses.
 double sphere_depth(const CameraIntrinsics& cam, double u, double v, const Eigen::Vector3d& centre, double radius) {
@@ -265,6 +258,13 @@ double sphere_depth(const CameraIntrinsics& cam, double u, double v, const Eigen
   return disc < 0.0 ? 0.0 : (b - std::sqrt(disc)) / ray.squaredNorm();
 }
 
+// A user close to the camera (body_eraser.hpp): the torso, rounded (a sphere of radius 200 mm
+// centred at (torso_x_mm, 0, 540 mm): its front 340 mm away), seen where it is less than
+// 60 mm deeper than its front; the hand, an elliptic bump (about 55 x 80 mm) at 450 mm right of the
+// image centre, with its forearm down to the bottom edge; beyond both, 800 mm. With `arm`, a band
+// joins the torso to the hand, its depth running from one to the other: torso, arm and hand are one
+// surface. Marks each pixel as torso (1) or hand (2; its forearm not) in `part`.
+// hand_alone() is the same scene without the torso (and the arm): what the hand is without them.
 DepthImage body_scene(const CameraIntrinsics& cam, double torso_x_mm, bool arm, std::vector<uint8_t>& part) {
   const auto n = static_cast<size_t>(cam.width) * cam.height;
   DepthImage img{cam, std::vector<float>(n, 800.0F)};

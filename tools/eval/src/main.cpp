@@ -225,7 +225,8 @@ int main(int argc, char** argv) {
   std::string hand_profile;
   app.add_option("--hand-profile", hand_profile, "hand profile (handtrack-calibrate): the user's hand scale (Sec. 6)");
   app.add_option("--recheck-frames", config.recheck_interval_frames,
-                 "recheck a fit whose running confidence is below 0.8 every N frames (default 0: never; "
+                 "recheck a fit whose running confidence is below recheck_below_confidence (0.8) every N frames "
+                 "(default 0: never; "
                  "docs/TRACKER.md, \"Rechecks of a mediocre fit\")")
       ->check(CLI::Range(0, 100000));
   bool sim_only = false;
