@@ -64,6 +64,11 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
   // The surfaces this hand may be segmented from: the filtered depth, without the foreign pixels
   // (out.filtered_mm keeps them: they still hide what is behind them).
   own_mm_.resize(n);  // on the first frame, not on the first with foreign pixels (no allocation later)
+  // And the start path's buffers (label_surfaces below), so that the first check that segments
+  // afresh, many frames on, does not allocate either.
+  component_.resize(n);
+  blobs_.reserve(n);
+  stack_.reserve(n);
   if (foreign != nullptr && foreign->size() == n) {
     for (size_t i = 0; i < n; ++i) own_mm_[i] = (*foreign)[i] != 0 ? 0.0F : out.filtered_mm[i];
   }

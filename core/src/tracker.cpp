@@ -354,7 +354,7 @@ void PoseTracker::reset() {
   before_previous_.reset();
   low_confidence_run_ = 0;
   confidence_level_ = 0.0;
-  check_next_ = false;
+  next_check_ = CheckCause::kNone;
   check_ = {};
   frames_since_check_ = 0;
 }
@@ -383,7 +383,7 @@ size_t PoseTracker::start_count(const HandPlace& place) {
 
 std::optional<HandHint> PoseTracker::hint() const {
   // A check's hypotheses are placed on a freshly segmented hand, not where the doubted pose says.
-  if (!previous_ || check_next_) return std::nullopt;
+  if (!previous_ || next_check_ != CheckCause::kNone) return std::nullopt;
   // Only the global transform matters (no PosedHand: nothing is allocated on the hot path).
   const Vector3d t = previous_->segment<3>(kTranslationParam);
   const Eigen::Matrix3d camera_R_hand = rotation_exp(previous_->segment<3>(kRotationParam)) * frontal_rotation();
@@ -416,7 +416,6 @@ PoseParams PoseTracker::initial_pose(const HandPlace& place, const Start& start)
       }
     }
   }
-  const PosedHand at_origin(model_, params);
   // The segmented palm centre is a surface point; the model's palm centre lies behind it: half a
   // palm thickness behind the palm or the back, half the palm's width behind an edge. A closed hand
   // with its palm toward the camera shows its curled fingers, which lie in front of the palm by
@@ -431,7 +430,9 @@ PoseParams PoseTracker::initial_pose(const HandPlace& place, const Start& start)
   const double behind_surface = facing * palm_half_thickness + (1.0 - facing) * palm_half_width +
                                 (start.closed ? palm_toward * kClosedFingersInFrontMm : 0.0);
   const Vector3d target = place.palm_centre_mm + Vector3d(0, 0, behind_surface);
-  const Vector3d centre = at_origin.camera_R_hand() * model_.palm_centre();
+  // The model's palm centre turned as the pose turns it (camera_R_hand = exp([r]x) R0; no PosedHand:
+  // a check screens hypotheses on the hot path, where nothing is allocated).
+  const Vector3d centre = rotation_exp(params.segment<3>(kRotationParam)) * frontal_rotation() * model_.palm_centre();
   params.segment<3>(kTranslationParam) = target - centre;
   return params;
 }
@@ -551,20 +552,20 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input, CheckPace pace) {
 
   scratch_.update(model_, best.params);
   Explained explained = explain(input, scratch_);
-  if (check_next_ && previous_) {
+  if (next_check_ != CheckCause::kNone && previous_) {
     // The hypotheses are placed on this frame's hand, segmented afresh (hint()), not where the
     // doubted pose says; the later frames of the check are segmented with the hint again (a fresh
     // segmentation on each of them lost the hand in one of them: docs/TRACKER.md).
     const HandPlace place{input.palm_centre_mm, input.finger_axis};
-    check_ = Check{true, place, input.hand_centroid_mm, start_count(place), 0, 0};
+    check_ = Check{true, next_check_, place, input.hand_centroid_mm, start_count(place), 0, 0};
     screened_.clear();
-    check_next_ = false;
+    next_check_ = CheckCause::kNone;
   }
   if (check_.active) {
     // A suspected gross error: the tracked pose competes with the (re)start hypotheses, searched
     // for over the next frames (continue_check); a (re)start replaces it only when it explains
-    // more of the hand on the same frame, so a check cannot make good tracking worse by this
-    // measure.
+    // clearly more of the hand on the same frame (check_replace_margin), so a check cannot make
+    // good tracking worse by this measure.
     const std::optional<Fit> fresh = continue_check(input, explained, pace);
     check = fresh ? CheckOutcome::kRestartWon : check_.active ? CheckOutcome::kChecking : CheckOutcome::kTrackedKept;
     if (fresh) {
@@ -703,7 +704,8 @@ std::optional<PoseTracker::Fit> PoseTracker::continue_check(const DepthInput& in
   const Fit best = refine(input, iterations);
   if (!last) return std::nullopt;
   check_.active = false;
-  return best.explained.score() > tracked.score() ? std::optional<Fit>(best) : std::nullopt;
+  return best.explained.score() > tracked.score() + config_.check_replace_margin ? std::optional<Fit>(best)
+                                                                                 : std::nullopt;
 }
 
 void PoseTracker::watch_confidence(double conf, CheckOutcome check) {
@@ -715,10 +717,12 @@ void PoseTracker::watch_confidence(double conf, CheckOutcome check) {
   // less (a hand turned sideways) is not checked again and again.
   //
   // A wrong pose that never fell (a (re)start that chose it) is only found by looking again: a
-  // level below recheck_below_confidence is rechecked every recheck_interval_frames frames.
+  // level below recheck_below_confidence is rechecked every recheck_interval_frames frames. A
+  // recheck that keeps the tracked pose leaves the level alone: nothing fell, and a fall that
+  // comes while it runs (a fist forming that the fit does not follow) must still be suspect.
   const bool first = confidence_level_ <= 0.0;
   const bool suspect = !first && conf < config_.suspect_confidence_ratio * confidence_level_;
-  if (first || check == CheckOutcome::kTrackedKept) {
+  if (first || (check == CheckOutcome::kTrackedKept && check_.cause == CheckCause::kFall)) {
     confidence_level_ = conf;
   } else if (!suspect) {
     confidence_level_ += config_.confidence_level_rate * (conf - confidence_level_);
@@ -726,7 +730,8 @@ void PoseTracker::watch_confidence(double conf, CheckOutcome check) {
   frames_since_check_ = check == CheckOutcome::kNone ? frames_since_check_ + 1 : 0;
   const bool recheck = config_.recheck_interval_frames > 0 && frames_since_check_ >= config_.recheck_interval_frames &&
                        confidence_level_ < config_.recheck_below_confidence;
-  check_next_ = (suspect || recheck) && !check_.active && frames_since_check_ >= config_.check_interval_frames;
+  const bool due = !check_.active && frames_since_check_ >= config_.check_interval_frames;
+  next_check_ = !due ? CheckCause::kNone : suspect ? CheckCause::kFall : recheck ? CheckCause::kRecheck : CheckCause::kNone;
 }
 
 bool PoseTracker::fuses(const DepthInput& input) const {

@@ -149,6 +149,9 @@ const std::vector<Field>& fields() {
     {"tracker.recheck_below_confidence",
      DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.recheck_below_confidence; }}, 0, 1,
      "running confidence below which a fit is rechecked every recheck_interval_frames", true},
+    {"tracker.check_replace_margin",
+     DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.check_replace_margin; }}, 0, 1,
+     "a check's restart pose replaces the tracked one only when its fit score is higher by more than this", true},
     {"tracker.check_iterations_per_frame",
      IntRef{[](DaemonConfig& c) -> int& { return c.tracker.check_iterations_per_frame; }}, 0, 1000,
      "0: a check is made on one frame (10-16 ms); N: spread over frames, about N iterations each (64: every frame "

@@ -106,13 +106,14 @@ TEST(TrackingRecovery, BackWithin30FramesAfterAGrossError) {
   }
 }
 
-// Rechecks of a mediocre fit (TrackerConfig::recheck_interval_frames, off by default; here every
-// 30 frames below a confidence of 0.8): a wrong pose whose confidence never fell past the suspect
-// ratio is still checked while it explains little of the hand. With the suspect check off, the knocks above are found only by the rechecks (and the lost
-// rule): every knock back within 30 frames. The same knocks without rechecks show the scenario
-// needs them: then some knock is not back (the lost rule alone: docs/TRACKER.md, "Recovery").
-// Measured: with rechecks 6 of 6 back after 2-3 frames, without 2 of 6. (flexex1 is left out: a
-// check shortly before its knock at frame 60 made the recheck wait 24 frames, by design up to 30.)
+// Rechecks of a mediocre fit (TrackerConfig::recheck_interval_frames: every 30 frames below a
+// confidence of 0.8): a wrong pose whose confidence never fell past the suspect ratio is still
+// checked while it explains little of the hand. With the suspect check off, the knocks above are
+// found only by the rechecks (and the lost rule): every knock back within 30 frames. The same
+// knocks without rechecks show the scenario needs them: then some knock is not back (the lost rule
+// alone: docs/TRACKER.md, "Recovery"). Measured: with rechecks 6 of 6 back after 2-3 frames,
+// without 2 of 6. (flexex1 is left out: a check shortly before its knock at frame 60 made the
+// recheck wait 24 frames, by design up to 30.)
 TEST(TrackingRecovery, AMediocreFitIsRecheckedThoughItsConfidenceNeverFell) {
   const PartForest forest = PartForest::load(shipped_forest_path().value());
   TrackerConfig config = testing::paper_config(EnergyMode::kLateFusion);

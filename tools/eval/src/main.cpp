@@ -226,8 +226,7 @@ int main(int argc, char** argv) {
   app.add_option("--hand-profile", hand_profile, "hand profile (handtrack-calibrate): the user's hand scale (Sec. 6)");
   app.add_option("--recheck-frames", config.recheck_interval_frames,
                  "recheck a fit whose running confidence is below recheck_below_confidence (0.8) every N frames "
-                 "(default 0: never; "
-                 "docs/TRACKER.md, \"Rechecks of a mediocre fit\")")
+                 "(default 30; 0: never; docs/TRACKER.md, \"Rechecks of a mediocre fit\")")
       ->check(CLI::Range(0, 100000));
   bool sim_only = false;
   app.add_flag("--sim-only", sim_only, "E_sim only: drop E_col, E_lim and E_smo (ablation of Fig. 6)");
