@@ -92,7 +92,7 @@ struct TrackerConfig {
   // share of the hand explained times the share of labels agreeing) is higher by more than this.
   // Two fits a few hundredths apart are a coin flip: on the broadened benchmark (seeds 1-6)
   // replacements by less than 0.1 made the fingertip error worse on average, by more made it
-  // better (docs/TRACKER.md, "A margin for a check's replacement").
+  // better (docs/TRACKER.md, "Rechecks of a mediocre fit").
   double check_replace_margin = 0.1;
   // 0: a check is made on one frame (10-16 ms here). N > 0: spread over frames at about N optimiser
   // iterations per frame on top of tracking (PoseTracker::continue_check): at 64, 4 hypotheses
