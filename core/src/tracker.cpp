@@ -731,7 +731,10 @@ void PoseTracker::watch_confidence(double conf, CheckOutcome check) {
   const bool recheck = config_.recheck_interval_frames > 0 && frames_since_check_ >= config_.recheck_interval_frames &&
                        confidence_level_ < config_.recheck_below_confidence;
   const bool due = !check_.active && frames_since_check_ >= config_.check_interval_frames;
-  next_check_ = !due ? CheckCause::kNone : suspect ? CheckCause::kFall : recheck ? CheckCause::kRecheck : CheckCause::kNone;
+  next_check_ = !due      ? CheckCause::kNone
+                : suspect ? CheckCause::kFall
+                : recheck ? CheckCause::kRecheck
+                          : CheckCause::kNone;
 }
 
 bool PoseTracker::fuses(const DepthInput& input) const {
