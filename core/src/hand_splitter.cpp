@@ -167,7 +167,6 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
   const int w = cam.width;
   const int h = cam.height;
   const auto n = static_cast<size_t>(w) * h;
-  stack_.reserve(n);  // label_surfaces' flood fill holds at most every pixel
   // Every slot's mask sized on the first frame, not on the first frame that needs it (a pipeline
   // frame's first second hand may come long after start-up).
   for (auto& mask : foreign) mask.resize(n);

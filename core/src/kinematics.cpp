@@ -27,6 +27,10 @@ Matrix3d rotation_exp(const Vector3d& r) {
   return Eigen::AngleAxisd(theta, r / theta).toRotationMatrix();
 }
 
+Matrix3d hand_rotation(const PoseParams& params) {
+  return rotation_exp(params.segment<3>(kRotationParam)) * frontal_rotation();
+}
+
 Matrix3d right_jacobian(const Vector3d& r) {
   // J_r(r) = I - (1 - cos t)/t^2 [r]x + (t - sin t)/t^3 [r]x^2, with its Taylor series near t = 0.
   const double t2 = r.squaredNorm();

@@ -9,7 +9,10 @@ void label_surfaces(const DepthInputConfig& config, const std::vector<float>& d,
   const auto n = static_cast<size_t>(w) * h;
   component.assign(n, -1);
   surfaces.clear();
-  surfaces.reserve(n);  // a surface per pixel at most: no allocation once a frame was seen
+  // A surface per pixel at most, and the flood fill holds at most every pixel: no allocation once
+  // a frame was seen.
+  surfaces.reserve(n);
+  stack.reserve(n);
   for (size_t seed = 0; seed < n; ++seed) {
     if (d[seed] <= 0.0F || component[seed] >= 0) continue;
     const int id = static_cast<int>(surfaces.size());

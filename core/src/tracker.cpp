@@ -386,7 +386,7 @@ std::optional<HandHint> PoseTracker::hint() const {
   if (!previous_ || next_check_ != CheckCause::kNone) return std::nullopt;
   // Only the global transform matters (no PosedHand: nothing is allocated on the hot path).
   const Vector3d t = previous_->segment<3>(kTranslationParam);
-  const Eigen::Matrix3d camera_R_hand = rotation_exp(previous_->segment<3>(kRotationParam)) * frontal_rotation();
+  const Eigen::Matrix3d camera_R_hand = hand_rotation(*previous_);
   return HandHint{t + camera_R_hand * model_.palm_centre(), t, camera_R_hand * Vector3d::UnitY()};
 }
 
@@ -430,9 +430,9 @@ PoseParams PoseTracker::initial_pose(const HandPlace& place, const Start& start)
   const double behind_surface = facing * palm_half_thickness + (1.0 - facing) * palm_half_width +
                                 (start.closed ? palm_toward * kClosedFingersInFrontMm : 0.0);
   const Vector3d target = place.palm_centre_mm + Vector3d(0, 0, behind_surface);
-  // The model's palm centre turned as the pose turns it (camera_R_hand = exp([r]x) R0; no PosedHand:
-  // a check screens hypotheses on the hot path, where nothing is allocated).
-  const Vector3d centre = rotation_exp(params.segment<3>(kRotationParam)) * frontal_rotation() * model_.palm_centre();
+  // The model's palm centre turned as the pose turns it (no PosedHand: a check screens hypotheses
+  // on the hot path, where nothing is allocated).
+  const Vector3d centre = hand_rotation(params) * model_.palm_centre();
   params.segment<3>(kTranslationParam) = target - centre;
   return params;
 }

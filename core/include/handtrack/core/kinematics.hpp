@@ -29,6 +29,8 @@ Eigen::Matrix3d rotation_exp(const Eigen::Vector3d& r);
 Eigen::Matrix3d right_jacobian(const Eigen::Vector3d& r);
 // log of a rotation matrix: the r with exp([r]x) = R, |r| <= pi.
 Eigen::Vector3d rotation_log(const Eigen::Matrix3d& rotation);
+// camera_R_hand = exp([r]x) R0 of a pose, without posing the hand (PosedHand allocates).
+Eigen::Matrix3d hand_rotation(const PoseParams& params);
 
 // dE/d centre (camera frame) of every model Gaussian, one column each. A fixed capacity keeps it
 // on the stack: no allocation per energy evaluation.
