@@ -177,6 +177,8 @@ void Tracker::resume(const TrackerOutput& last) {
   side(opposite(current_)).reset();
   trial_pending_ = false;
   trial_frames_ = 0;
+  retrial_ = false;
+  frames_since_trial_ = 0;
 }
 
 void Tracker::reset() {
@@ -184,6 +186,7 @@ void Tracker::reset() {
   left_.reset();
   trial_pending_ = true;
   trial_frames_ = 0;
+  retrial_ = false;
   hand_id_ = 0;
 }
 
@@ -273,8 +276,21 @@ void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left)
   // the user; later, the hand reported so far is kept until the evidence leaves the tie (the palm
   // rule on every frame of a tie, replayed over the benchmark's logs: handedness 92.6 -> 92.0 %,
   // wrong for every hand seen from the back).
+  //
+  // A trial of a hand already chosen (retrial_: TrackerConfig::handedness_recheck_frames) reports
+  // that hand throughout: it checks a tracked pose against a (re)start, where one clear frame of
+  // the restarted hand is no evidence. The other hand takes over only if the evidence favours it by
+  // handedness_margin at the end; the trial ends early, after a third of its frames, where the
+  // evidence already favours the chosen hand by the margin (most find the chosen hand right).
   const bool tie = std::abs(evidence_) < config().handedness_tie;
-  if (!tie) {
+  const bool clear = std::abs(evidence_) >= config().handedness_margin;
+  const int frames = trial_frames_ + 1;
+  const bool favours_current = (evidence_ > 0.0) == (current_ == Handedness::kLeft);
+  const bool confirmed = retrial_ && clear && favours_current && 3 * frames >= config().handedness_trial_frames;
+  const bool done = confirmed || (frames >= config().handedness_trial_frames && (clear || retrial_));
+  if (retrial_) {
+    if (done && clear) current_ = evidence_ > 0.0 ? Handedness::kLeft : Handedness::kRight;
+  } else if (!tie) {
     current_ = evidence_ > 0.0 ? Handedness::kLeft : Handedness::kRight;
   } else if (expected_) {
     current_ = *expected_;
@@ -283,9 +299,11 @@ void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left)
   }
   ++trial_frames_;
   trial_pending_ = false;
-  if (trial_frames_ >= config().handedness_trial_frames && std::abs(evidence_) >= config().handedness_margin) {
+  if (done) {
     side(opposite(current_)).reset();
     trial_frames_ = 0;
+    retrial_ = false;
+    frames_since_trial_ = 0;
   }
 }
 
@@ -329,6 +347,17 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
   if (side(current_).lost() && (trial_frames_ == 0 || side(opposite(current_)).lost())) {
     trial_pending_ = true;
     trial_frames_ = 0;
+    retrial_ = false;
+  } else if (config().handedness == HandednessMode::kAuto && !both()) {
+    // A hand chosen by a trial and tracked alone since: put to a trial again while its fit stays
+    // mediocre (TrackerConfig::handedness_recheck_frames). Its first frame is a whole (re)start
+    // search of the other hand, which the latency setting (checks spread over frames) makes on no
+    // tracked frame: there, none.
+    const int every = config().check_iterations_per_frame > 0 ? 0 : config().handedness_recheck_frames;
+    if (every > 0 && ++frames_since_trial_ >= every && side(current_).mediocre()) {
+      trial_pending_ = true;
+      retrial_ = true;
+    }
   }
   out.iterations = right_.take_iterations() + left_.take_iterations();
   // 1 when only one hand is considered.

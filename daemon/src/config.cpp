@@ -124,6 +124,11 @@ const std::vector<Field>& fields() {
                "auto, left, right"},
      0, 0, "auto | left | right: which hand the tracker fits (auto: both from every (re)start, until several frames tell)",
      true},
+    {"tracker.handedness_recheck_frames",
+     IntRef{[](DaemonConfig& c) -> int& { return c.tracker.handedness_recheck_frames; }}, 0, 100000,
+     "auto: a hand whose fit stays below recheck_below_confidence is tried as the other hand again every this many "
+     "frames (0: never; never with check_iterations_per_frame > 0)",
+     true},
     {"tracker.max_hands", IntRef{[](DaemonConfig& c) -> int& { return c.tracker.max_hands; }}, 1, kMaxHands,
      "hands tracked at once (each its own id, handedness and pose; optimized on two cores)", true},
     {"tracker.init_iterations", IntRef{[](DaemonConfig& c) -> int& { return c.tracker.init_iterations; }}, 1, 1000,

@@ -228,6 +228,10 @@ int main(int argc, char** argv) {
                  "recheck a fit whose running confidence is below recheck_below_confidence (0.8) every N frames "
                  "(default 30; 0: never; docs/TRACKER.md, \"Rechecks of a mediocre fit\")")
       ->check(CLI::Range(0, 100000));
+  app.add_option("--handedness-recheck-frames", config.handedness_recheck_frames,
+                 "try a hand whose fit stays below recheck_below_confidence as the other hand again every N frames "
+                 "(default 60; 0: never; docs/TRACKER.md, \"Handedness by evidence over frames\")")
+      ->check(CLI::Range(0, 100000));
   bool sim_only = false;
   app.add_flag("--sim-only", sim_only, "E_sim only: drop E_col, E_lim and E_smo (ablation of Fig. 6)");
   int max_hands = kMaxHands;

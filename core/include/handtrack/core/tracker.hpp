@@ -117,6 +117,14 @@ struct TrackerConfig {
   double handedness_tie = 0.05;
   int handedness_trial_frames = 30;
   double handedness_evidence_rate = 0.05;
+  // A hand chosen by a trial whose fit stays mediocre (its running confidence below
+  // recheck_below_confidence) is put to a trial again every `handedness_recheck_frames` frames: the
+  // other hand from its (re)start, side by side for handedness_trial_frames frames (fewer where the
+  // evidence soon favours the chosen hand by handedness_margin), and taken only if the evidence
+  // then favours it by that margin (Tracker::weigh); 0: never, and never with checks spread over
+  // frames. A fist at the trial's start is explained as well by either hand, and the wrong one, once
+  // chosen, stayed (docs/TRACKER.md, "Handedness by evidence over frames").
+  int handedness_recheck_frames = 60;
   // Hands per frame (HandsTracker; 1..kMaxHands): hands_tracker.hpp.
   int max_hands = 2;
   // A surface that a new hand's (re)start found to be no hand is not tried again for this many
@@ -193,6 +201,10 @@ class PoseTracker {
   int take_iterations() { return std::exchange(iterations_, 0); }
   // No tracked pose: the next frame (re)starts.
   [[nodiscard]] bool lost() const { return !previous_; }
+  // The running confidence of the tracked pose is below TrackerConfig::recheck_below_confidence.
+  [[nodiscard]] bool mediocre() const {
+    return previous_ && confidence_level_ < config_.recheck_below_confidence;
+  }
   // Optimises the pose for one frame's C_I and updates the history.
   // How a check of a suspect fit is made: its search spread over the next frames (the fit stays
   // the tracked one meanwhile; TrackerConfig::check_iterations_per_frame > 0), or all on this frame.
@@ -412,6 +424,11 @@ class Tracker {
   bool trial_pending_ = true;
   int trial_frames_ = 0;
   double evidence_ = 0.0;
+  // A trial of a hand already chosen (TrackerConfig::handedness_recheck_frames): the chosen hand
+  // is reported throughout and kept unless the evidence is clear at the end. Frames since the last
+  // trial ended.
+  bool retrial_ = false;
+  int frames_since_trial_ = 0;
   uint32_t hand_id_ = 0;   // of the hand in view; 0: none in the last frame
   uint32_t last_hand_id_ = 0;
 };
