@@ -32,8 +32,9 @@ inline synth::SyntheticCamera motion_camera(std::string_view motion) {
   return synth::SyntheticCamera(options);
 }
 
-// One rendered hand tracked by a Tracker: the mean fingertip error over the frames with a pose, how
-// many had one, and how many of those were reported as the hand shown.
+// One rendered hand tracked by a Tracker (every frame), scored from frame `from_frame` on: the mean
+// fingertip error over the scored frames with a pose, how many had one, and how many of those were
+// reported as the hand shown.
 struct OneHandRun {
   double mean_error_mm = 0.0;
   int posed = 0;
@@ -41,7 +42,7 @@ struct OneHandRun {
 };
 
 inline OneHandRun track_one_hand(const synth::SynthOptions& options, const TrackerConfig& config,
-                                 const PixelLabeller* labeller = nullptr) {
+                                 const PixelLabeller* labeller = nullptr, int from_frame = 0) {
   synth::SyntheticCamera camera(options);
   Tracker tracker(config);
   const Handedness shown = options.hand == synth::Handedness::kLeft ? Handedness::kLeft : Handedness::kRight;
@@ -51,7 +52,7 @@ inline OneHandRun track_one_hand(const synth::SynthOptions& options, const Track
   for (int i = 0; i < options.frames; ++i) {
     camera.render(i, frame);
     const TrackerOutput out = tracker.track(frame.depth, labeller);
-    if (out.state == TrackingState::kNoHand) continue;
+    if (i < from_frame || out.state == TrackingState::kNoHand) continue;
     ++run.posed;
     run.reported_as_shown += out.handedness == shown ? 1 : 0;
     double e = 0.0;

@@ -137,24 +137,6 @@ INSTANTIATE_TEST_SUITE_P(DepthOnlyAndShipped, RealHands,
 // the second half of the sequence. Without those trials it never does, which this test also checks,
 // so that it keeps exercising them. Measured: all of frames 150-299 with them, none
 // without (docs/TRACKER.md, "A mediocre fit is tried as the other hand again").
-double share_reported_as_shown_from(const synth::SynthOptions& options, const TrackerConfig& config,
-                                    const PixelLabeller& labeller, int from_frame) {
-  synth::SyntheticCamera camera(options);
-  Tracker tracker(config);
-  const Handedness shown = options.hand == synth::Handedness::kLeft ? Handedness::kLeft : Handedness::kRight;
-  int posed = 0;
-  int as_shown = 0;
-  synth::SynthFrame frame;
-  for (int i = 0; i < options.frames; ++i) {
-    camera.render(i, frame);
-    const TrackerOutput out = tracker.track(frame.depth, &labeller);
-    if (i < from_frame || out.state == TrackingState::kNoHand) continue;
-    ++posed;
-    as_shown += out.handedness == shown ? 1 : 0;
-  }
-  return posed > 0 ? static_cast<double>(as_shown) / posed : 0.0;
-}
-
 TEST(HandednessRetrial, AHandChosenWrongOnAFistIsTriedAgain) {
   const PartForest forest = PartForest::load(shipped_forest_path().value());
   synth::SynthOptions options;
@@ -167,8 +149,12 @@ TEST(HandednessRetrial, AHandChosenWrongOnAFistIsTriedAgain) {
   config.mode = EnergyMode::kLateFusion;
   TrackerConfig without = config;
   without.handedness_recheck_frames = 0;
-  const double with_share = share_reported_as_shown_from(options, config, forest, 150);
-  const double without_share = share_reported_as_shown_from(options, without, forest, 150);
+  const auto share_as_shown = [&](const TrackerConfig& c) {
+    const testing::OneHandRun run = testing::track_one_hand(options, c, &forest, 150);
+    return run.posed > 0 ? static_cast<double>(run.reported_as_shown) / run.posed : 0.0;
+  };
+  const double with_share = share_as_shown(config);
+  const double without_share = share_as_shown(without);
   std::printf("frames 150-299 reported as the right hand: %.2f with trials again, %.2f without\n", with_share,
               without_share);
   EXPECT_GE(with_share, 0.9);
