@@ -113,9 +113,10 @@ void HandsTracker::face_other_hands() {
     const Slot* other = other_seen(s);
     if (other == nullptr) continue;
     // Two hands in one frame are usually a left and a right one: the slot expects to be the hand
-    // the other is not (it decides choices between left and right that its fits leave open).
+    // the other is not (it decides choices between left and right that its fits leave open, and,
+    // where the other hand's side is the clearer of the two, those they do not make clear).
     const bool other_left = other->last.handedness == Handedness::kLeft;
-    slot.tracker.expect(other_left ? Handedness::kRight : Handedness::kLeft);
+    slot.tracker.expect(other_left ? Handedness::kRight : Handedness::kLeft, other->last.handedness_confidence);
     if ((fitting_ & (1U << static_cast<unsigned>(s))) == 0) continue;
     // The other hand's last params are the right-hand model's, in the mirrored image for a left
     // hand: posed as they are, its Gaussians are in the camera frame after mirroring x exactly when

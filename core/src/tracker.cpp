@@ -271,7 +271,11 @@ void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left)
   evidence_ = trial_frames_ == 0 ? difference
                                  : evidence_ + config().handedness_evidence_rate * (difference - evidence_);
   // Evidence within handedness_tie is a tie. With another hand in view (HandsTracker) a tie goes to
-  // the hand that one is not: two hands in one frame are usually a left and a right one. Else, on
+  // the hand that one is not: two hands in one frame are usually a left and a right one. So does
+  // evidence short of handedness_margin where the other hand's is the clearer (expect()): the
+  // clearer hand decides the pair. Clapping hands, side-on to the camera, stay in a trial with
+  // evidence near the tie, and one of them turned to the other's side on evidence of 0.05, the
+  // other following it within its tie, both wrong (docs/TRACKER.md, "Two hands"). Else, on
   // the trial's first frame, to the palm toward the camera, the common view of a desk camera facing
   // the user; later, the hand reported so far is kept until the evidence leaves the tie (the palm
   // rule on every frame of a tie, replayed over the benchmark's logs: handedness 92.6 -> 92.0 %,
@@ -288,10 +292,13 @@ void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left)
   const bool favours_current = (evidence_ > 0.0) == (current_ == Handedness::kLeft);
   const bool confirmed = retrial_ && clear && favours_current && 3 * frames >= config().handedness_trial_frames;
   const bool done = confirmed || (frames >= config().handedness_trial_frames && (clear || retrial_));
+  const Handedness favoured = evidence_ > 0.0 ? Handedness::kLeft : Handedness::kRight;
+  const bool other_decides =
+      expected_ && favoured != *expected_ && !clear && expected_clarity_ > std::abs(evidence_);
   if (retrial_) {
-    if (done && clear) current_ = evidence_ > 0.0 ? Handedness::kLeft : Handedness::kRight;
-  } else if (!tie) {
-    current_ = evidence_ > 0.0 ? Handedness::kLeft : Handedness::kRight;
+    if (done && clear) current_ = favoured;
+  } else if (!tie && !other_decides) {
+    current_ = favoured;
   } else if (expected_) {
     current_ = *expected_;
   } else if (trial_frames_ == 0) {

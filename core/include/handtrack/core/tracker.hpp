@@ -392,8 +392,12 @@ class Tracker {
     left_.set_other_hand(as_left);
   }
   // Which hand this one probably is (HandsTracker: not the other hand in view), for choices within
-  // handedness_tie; nullopt: no expectation.
-  void expect(std::optional<Handedness> hand) { expected_ = hand; }
+  // handedness_tie, and for choices short of handedness_margin while the other hand's side is the
+  // clearer choice (`other_clarity`: its handedness_confidence); nullopt: no expectation.
+  void expect(std::optional<Handedness> hand, double other_clarity = 0.0) {
+    expected_ = hand;
+    expected_clarity_ = other_clarity;
+  }
   // Track both hands again from the next frame, in a new trial (HandsTracker: both hands in view
   // were chosen as the same hand); a trial under way goes on.
   void question_handedness() { trial_pending_ = trial_pending_ || trial_frames_ == 0; }
@@ -418,6 +422,7 @@ class Tracker {
   TrackerInputs inputs_;  // track()'s
   Handedness current_ = Handedness::kRight;
   std::optional<Handedness> expected_;  // expect()
+  double expected_clarity_ = 0.0;
   // Handedness trial (TrackerConfig::handedness_trial_frames): due at the next frame with both
   // hands' inputs, its frames so far (0: none under way), and the running evidence (the average
   // fit-score difference left - right; TrackerOutput::handedness_confidence is its size).
