@@ -289,10 +289,9 @@ void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left)
   const bool tie = std::abs(evidence_) < config().handedness_tie;
   const bool clear = std::abs(evidence_) >= config().handedness_margin;
   const int frames = trial_frames_ + 1;
-  const bool favours_current = (evidence_ > 0.0) == (current_ == Handedness::kLeft);
-  const bool confirmed = retrial_ && clear && favours_current && 3 * frames >= config().handedness_trial_frames;
-  const bool done = confirmed || (frames >= config().handedness_trial_frames && (clear || retrial_));
   const Handedness favoured = evidence_ > 0.0 ? Handedness::kLeft : Handedness::kRight;
+  const bool confirmed = retrial_ && clear && favoured == current_ && 3 * frames >= config().handedness_trial_frames;
+  const bool done = confirmed || (frames >= config().handedness_trial_frames && (clear || retrial_));
   const bool other_decides =
       expected_ && favoured != *expected_ && !clear && expected_clarity_ > std::abs(evidence_);
   if (retrial_) {
