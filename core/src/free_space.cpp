@@ -84,93 +84,115 @@ void FreeSpaceMap::build(const CameraIntrinsics& camera, const std::vector<float
   }
   if (u_hi < 0) return;
   // The cap in pixels where it is largest, at the hand's nearest depth; the box reaches that far
-  // around the hand, and one pixel beyond the image (not free: the hand may go on there).
+  // around the hand and a cell more (sample() ramps to the cap over the half cell beyond the
+  // box's last cell centres), and a cell beyond the image (not free: the hand may go on there).
+  // Cells are aligned with the image (at even pixels), so that with an even width and height no
+  // cell holds pixels both on and off the image.
   cap_px_ = config.cap_mm * camera.focal() / near_mm;
-  const int reach = static_cast<int>(std::ceil(cap_px_)) + 1;
-  u0_ = std::max(-1, u_lo - reach);
-  v0_ = std::max(-1, v_lo - reach);
-  width_ = std::min(w, u_hi + reach + 1) - u0_ + 1;
-  height_ = std::min(h, v_hi + reach + 1) - v0_ + 1;
-  const size_t box = static_cast<size_t>(width_) * static_cast<size_t>(height_);
-  const size_t room = static_cast<size_t>(w + 2) * static_cast<size_t>(h + 2);
-  if (distance_px_.capacity() < room) distance_px_.reserve(room);
-  if (scratch_.capacity() < room) scratch_.reserve(room);
-  // The row transform's scratch: at most one entry per box column (w + 2), and one more bound.
-  if (site_.capacity() < static_cast<size_t>(w + 2)) {
-    site_.reserve(static_cast<size_t>(w + 2));
-    bound_.reserve(static_cast<size_t>(w + 3));
+  const int reach = static_cast<int>(std::ceil(cap_px_)) + 1 + kCellPx;
+  const auto cell_start = [](int p) { return p >= 0 ? p - p % kCellPx : -((kCellPx - 1 - p) / kCellPx) * kCellPx; };
+  u0_ = std::max(-kCellPx, cell_start(u_lo - reach));
+  v0_ = std::max(-kCellPx, cell_start(v_lo - reach));
+  width_ = (std::min(w + kCellPx - 1, u_hi + reach) - u0_) / kCellPx + 1;
+  height_ = (std::min(h + kCellPx - 1, v_hi + reach) - v0_) / kCellPx + 1;
+  const size_t cells = static_cast<size_t>(width_) * static_cast<size_t>(height_);
+  // Room for the largest box (the whole image and its ring) up front, and the row transform's
+  // scratch: at most one entry per column of cells, and one more bound.
+  const auto most_columns = static_cast<size_t>(w / kCellPx + 3);
+  const auto most_cells = most_columns * static_cast<size_t>(h / kCellPx + 3);
+  if (distance_px_.capacity() < most_cells) distance_px_.reserve(most_cells);
+  if (scratch_.capacity() < most_cells) scratch_.reserve(most_cells);
+  if (site_.capacity() < most_columns) {
+    site_.reserve(most_columns);
+    bound_.reserve(most_columns + 1);
   }
-  distance_px_.resize(box);
-  scratch_.resize(box);
+  distance_px_.resize(cells);
+  scratch_.resize(cells);
   site_.resize(static_cast<size_t>(width_));
   bound_.resize(static_cast<size_t>(width_) + 1);
+  // A cell is free (infinity) where all its pixels are free, not free (0) where any one is; pixels
+  // beyond the image are not free.
   const float free_beyond_mm = far_mm + static_cast<float>(config.margin_mm);
-  // The box's columns inside the image; the ring beyond it is not free.
-  const int x_in_begin = -u0_ > 0 ? -u0_ : 0;
-  const int x_in_end = std::min(width_, w - u0_);
-  for (int y = 0; y < height_; ++y) {
-    float* out = scratch_.data() + static_cast<size_t>(y) * width_;
-    std::fill(out, out + width_, 0.0F);
-    const int v = v0_ + y;
-    if (v < 0 || v >= h) continue;
+  std::fill(scratch_.begin(), scratch_.end(), kFar);
+  for (int v = std::max(0, v0_); v < std::min(h, v0_ + height_ * kCellPx); ++v) {
+    float* out = scratch_.data() + static_cast<size_t>((v - v0_) / kCellPx) * width_;
     const float* depth = depth_mm.data() + static_cast<size_t>(v) * w;
-    for (int x = x_in_begin; x < x_in_end; ++x) {
-      const float d = depth[u0_ + x];
-      out[x] = (d <= 0.0F || d > free_beyond_mm) ? kFar : 0.0F;
+    for (int u = std::max(0, u0_); u < std::min(w, u0_ + width_ * kCellPx); ++u) {
+      const float d = depth[u];
+      if (d > 0.0F && d <= free_beyond_mm) out[(u - u0_) / kCellPx] = 0.0F;
     }
   }
-  // Squared distances along the columns, then along the rows of those (separable: the exact EDT).
-  // Along a column the input is binary (0 or infinity): the distance to the nearest pixel that is
-  // not free is one sweep down and one up, a whole row at a time (vectorised).
-  const auto w_box = static_cast<size_t>(width_);
+  // The box's first or last column (row) of cells reaches beyond the image where it has a pixel
+  // outside it.
+  const bool left = u0_ < 0;
+  const bool right = u0_ + width_ * kCellPx > w;
+  const bool top = v0_ < 0;
+  const bool bottom = v0_ + height_ * kCellPx > h;
   for (int y = 0; y < height_; ++y) {
-    const float* in = scratch_.data() + y * w_box;
-    float* out = distance_px_.data() + y * w_box;
-    const float* above = y > 0 ? out - w_box : nullptr;
-    for (size_t x = 0; x < w_box; ++x) out[x] = in[x] == 0.0F ? 0.0F : (above != nullptr ? above[x] + 1.0F : kFar);
+    float* row = scratch_.data() + static_cast<size_t>(y) * width_;
+    if ((top && y == 0) || (bottom && y == height_ - 1)) std::fill(row, row + width_, 0.0F);
+    if (left) row[0] = 0.0F;
+    if (right) row[width_ - 1] = 0.0F;
+  }
+  // Squared distances (in cells) along the columns, then along the rows of those (separable: the
+  // exact EDT of the cells). Along a column the input is binary (0 or infinity): the distance to
+  // the nearest cell that is not free is one sweep down and one up, a whole row at a time
+  // (vectorised). A column distance at or beyond the cap stays beyond it in any row: such a cell
+  // roots no parabola.
+  const auto w_cells = static_cast<size_t>(width_);
+  for (int y = 0; y < height_; ++y) {
+    const float* in = scratch_.data() + y * w_cells;
+    float* out = distance_px_.data() + y * w_cells;
+    const float* above = y > 0 ? out - w_cells : nullptr;
+    for (size_t x = 0; x < w_cells; ++x) out[x] = in[x] == 0.0F ? 0.0F : (above != nullptr ? above[x] + 1.0F : kFar);
   }
   for (int y = height_ - 2; y >= 0; --y) {
-    float* out = distance_px_.data() + static_cast<size_t>(y) * w_box;
-    const float* below = out + w_box;
-    for (size_t x = 0; x < w_box; ++x) out[x] = std::min(out[x], below[x] + 1.0F);
+    float* out = distance_px_.data() + static_cast<size_t>(y) * w_cells;
+    const float* below = out + w_cells;
+    for (size_t x = 0; x < w_cells; ++x) out[x] = std::min(out[x], below[x] + 1.0F);
   }
-  for (float& d : distance_px_) d *= d;
+  const auto cap_cells = static_cast<float>(cap_px_ / kCellPx);
+  for (float& d : distance_px_) d = d < cap_cells ? d * d : kFar;
   for (int y = 0; y < height_; ++y) {
     float* row = distance_px_.data() + static_cast<ptrdiff_t>(y) * width_;
     std::copy(row, row + width_, scratch_.data());
     squared_distance_1d(scratch_.data(), width_, row, site_.data(), bound_.data());
   }
+  // From cells to pixels: a cell that is not free has a pixel half a pixel nearer than its centre
+  // (along the axes), so the distance from a free cell's centre is half a pixel less.
   const auto cap = static_cast<float>(cap_px_);
-  for (float& d : distance_px_) d = std::min(cap, std::sqrt(d));
+  constexpr float kNearerPx = 0.5F * (kCellPx - 1);
+  for (float& d : distance_px_) d = d > 0.0F ? std::min(cap, std::sqrt(d) * static_cast<float>(kCellPx) - kNearerPx) : 0.0F;
 }
 
-double FreeSpaceMap::at(int u, int v) const {
-  const int x = u - u0_;
-  const int y = v - v0_;
+double FreeSpaceMap::cell(int x, int y) const {
   if (x < 0 || y < 0 || x >= width_ || y >= height_) return cap_px_;
   return distance_px_[static_cast<size_t>(y) * width_ + x];
 }
 
+double FreeSpaceMap::at(int u, int v) const { return sample(u, v).distance_px; }
+
 FreeSpaceMap::Sample FreeSpaceMap::sample(double u, double v) const {
   if (empty() || !std::isfinite(u) || !std::isfinite(v)) return {cap_px_, 0.0, 0.0};
+  // In cells, the centre of cell (x, y) at (x, y): pixel u0 + kCellPx x + (kCellPx - 1) / 2.
+  const double x = (u - u0_ - 0.5 * (kCellPx - 1)) / kCellPx;
+  const double y = (v - v0_ - 0.5 * (kCellPx - 1)) / kCellPx;
   // Far outside the box: the cap (and no overflow in the conversion below).
-  const double lo_u = u0_ - 2.0;
-  const double lo_v = v0_ - 2.0;
-  if (u < lo_u || v < lo_v || u > u0_ + width_ + 1.0 || v > v0_ + height_ + 1.0) return {cap_px_, 0.0, 0.0};
-  const double fu = std::floor(u);
-  const double fv = std::floor(v);
-  const double a = u - fu;
-  const double b = v - fv;
-  const int i = static_cast<int>(fu);
-  const int j = static_cast<int>(fv);
-  const double d00 = at(i, j);
-  const double d10 = at(i + 1, j);
-  const double d01 = at(i, j + 1);
-  const double d11 = at(i + 1, j + 1);
+  if (x < -2.0 || y < -2.0 || x > width_ + 1.0 || y > height_ + 1.0) return {cap_px_, 0.0, 0.0};
+  const double fx = std::floor(x);
+  const double fy = std::floor(y);
+  const double a = x - fx;
+  const double b = y - fy;
+  const int i = static_cast<int>(fx);
+  const int j = static_cast<int>(fy);
+  const double d00 = cell(i, j);
+  const double d10 = cell(i + 1, j);
+  const double d01 = cell(i, j + 1);
+  const double d11 = cell(i + 1, j + 1);
   Sample s;
   s.distance_px = (1 - a) * (1 - b) * d00 + a * (1 - b) * d10 + (1 - a) * b * d01 + a * b * d11;
-  s.d_du = (1 - b) * (d10 - d00) + b * (d11 - d01);
-  s.d_dv = (1 - a) * (d01 - d00) + a * (d11 - d10);
+  s.d_du = ((1 - b) * (d10 - d00) + b * (d11 - d01)) / kCellPx;
+  s.d_dv = ((1 - a) * (d01 - d00) + a * (d11 - d10)) / kCellPx;
   return s;
 }
 

@@ -10,9 +10,12 @@
 // pixel by more than `margin_mm`; anything nearer (the hand, the forearm at the wrist, a body or
 // an object in front, the other hand) is not: a model part behind it is hidden, not floating.
 // Pixels outside the image are not free either (the hand may go on beyond the image's edge).
-// The map holds, for the pixels of a box around the hand, the Euclidean distance (px) to the
-// nearest pixel that is not free, capped at `cap_mm` at the hand's nearest depth: beyond the cap,
-// and outside the box, the distance is the cap and its gradient 0.
+// The map holds, for a box around the hand, the Euclidean distance (px) to the nearest pixel that
+// is not free, capped at `cap_mm` at the hand's nearest depth: beyond the cap, and outside the box,
+// the distance is the cap and its gradient 0. It is held at half resolution, in cells of 2 x 2
+// pixels, a cell not free where any of its pixels is not: within about a pixel of the exact
+// distance (E_free forgives 5 mm, 3-4 px at arm's length), at a quarter of the cost (measured in
+// docs/BENCHMARKS.md).
 
 #include "handtrack/core/camera.hpp"
 
@@ -47,16 +50,21 @@ class FreeSpaceMap {
   [[nodiscard]] bool empty() const { return distance_px_.empty(); }
   [[nodiscard]] double cap_px() const { return cap_px_; }
   [[nodiscard]] Sample sample(double u, double v) const;
-  // The distance at pixel (u, v); the cap outside the box.
+  // The distance at pixel (u, v): sample(u, v), the cap outside the box.
   [[nodiscard]] double at(int u, int v) const;
 
+  static constexpr int kCellPx = 2;  // a cell's side, in pixels
+
  private:
-  int u0_ = 0;  // the box: pixels [u0, u0 + width) x [v0, v0 + height), may reach one pixel beyond the image
-  int v0_ = 0;
+  // The distance at the centre of cell (x, y); the cap outside the box.
+  [[nodiscard]] double cell(int x, int y) const;
+
+  int u0_ = 0;  // the box: cells of pixels [u0 + 2x, u0 + 2x + 1] x [v0 + 2y, v0 + 2y + 1], x < width,
+  int v0_ = 0;  // y < height, at even pixels; it may reach a cell beyond the image
   int width_ = 0;
   int height_ = 0;
   double cap_px_ = 0.0;
-  std::vector<float> distance_px_;  // row-major over the box
+  std::vector<float> distance_px_;  // row-major over the cells
   std::vector<float> scratch_;      // build(): free (infinity) or not (0), then one row at a time
   std::vector<int> site_;           // build(): the row transform's parabola roots
   std::vector<float> bound_;        // and where each one's reign begins
