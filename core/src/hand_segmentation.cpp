@@ -155,13 +155,20 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
       body_.erase(own_mm_);
       label_surfaces(config, own_mm_, w, h, component_, stack_, blobs_);
     }
+    // Where the frame was shared out among hands (foreign pixels), the hand is the largest of the
+    // slot's own sizeable surfaces instead: touching hands are split pixel by pixel, which can
+    // leave a slot a sliver of the other hand nearer the camera than its own.
+    const bool shared_out = segmented == &own_mm_ && foreign != nullptr;
     int best = -1;
     double best_depth = std::numeric_limits<double>::infinity();
+    double best_area = 0.0;
     for (size_t b = 0; b < blobs_.size(); ++b) {
       const double mean = blobs_[b].mean_depth();
-      if (area_mm2(blobs_[b].pixels, mean) < config.min_hand_area_mm2) continue;
-      if (mean < best_depth) {
+      const double area = area_mm2(blobs_[b].pixels, mean);
+      if (area < config.min_hand_area_mm2) continue;
+      if (shared_out ? area > best_area : mean < best_depth) {
         best_depth = mean;
+        best_area = area;
         best = static_cast<int>(b);
       }
     }

@@ -418,6 +418,33 @@ TEST(HandsInputs, ANewHandIsNotABody) {
   }
 }
 
+TEST(DepthInput, AShareOfTheFrameSegmentedAfreshIsItsLargestSurface) {
+  // Touching hands are split pixel by pixel, which can leave a slot a sliver of the other hand
+  // nearer the camera than its own (two_clap, docs/TRACKER.md "Two hands"). Segmented afresh (a
+  // check: no hint), a slot's share of the frame is its largest sizeable surface; the whole frame,
+  // as one hand alone sees it, its nearest.
+  const auto cam = camera(320, 240);
+  DepthImage img = blob_scene(cam, 450, false);
+  for (int v = 20; v < 50; ++v) {
+    for (int u = 20; u < 50; ++u) img.at(u, v) = 350.0F;  // a sliver, 30 x 30 px, nearer
+  }
+  std::vector<uint8_t> foreign(img.depth_mm.size(), 0);
+  for (int v = 190; v < 230; ++v) {
+    for (int u = 250; u < 300; ++u) {
+      img.at(u, v) = 420.0F;  // the other slot's hand
+      foreign[static_cast<size_t>(v) * cam.width + u] = 1;
+    }
+  }
+  DepthInputBuilder whole;
+  const DepthInput& alone = whole.build(img, std::nullopt);
+  ASSERT_TRUE(alone.has_hand());
+  EXPECT_NEAR(alone.hand_centroid_mm.z(), 350.0, 5.0) << "the whole frame: its nearest surface";
+  DepthInputBuilder slot;
+  const DepthInput& share = slot.build(img, std::nullopt, nullptr, &foreign);
+  ASSERT_TRUE(share.has_hand());
+  EXPECT_NEAR(share.hand_centroid_mm.z(), 444.0, 10.0) << "a share of the frame: its largest surface";
+}
+
 TEST(DepthInput, MedianFilterRemovesFlyingPixels) {
   const auto cam = camera(320, 240);
   DepthImage img = blob_scene(cam, 400, false);
