@@ -69,11 +69,13 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
   component_.resize(n);
   blobs_.reserve(n);
   stack_.reserve(n);
-  if (foreign != nullptr && foreign->size() == n) {
+  // The frame shared out among hands: this slot's pixels are those not foreign.
+  const bool shared_out = foreign != nullptr && foreign->size() == n;
+  if (shared_out) {
     for (size_t i = 0; i < n; ++i) own_mm_[i] = (*foreign)[i] != 0 ? 0.0F : out.filtered_mm[i];
   }
   // What is segmented: the filtered depth, or own_mm_ where it differs (foreign pixels, a body).
-  const std::vector<float>* segmented = foreign != nullptr && foreign->size() == n ? &own_mm_ : &out.filtered_mm;
+  const std::vector<float>* segmented = shared_out ? &own_mm_ : &out.filtered_mm;
   out.hand_mask.assign(n, 0);
   out.hand_pixels = 0;
   const auto point = [&](size_t i) {
@@ -155,10 +157,9 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
       body_.erase(own_mm_);
       label_surfaces(config, own_mm_, w, h, component_, stack_, blobs_);
     }
-    // Where the frame was shared out among hands (foreign pixels), the hand is the largest of the
-    // slot's own sizeable surfaces instead: touching hands are split pixel by pixel, which can
-    // leave a slot a sliver of the other hand nearer the camera than its own.
-    const bool shared_out = segmented == &own_mm_ && foreign != nullptr;
+    // Where the frame was shared out among hands, the hand is the largest of the slot's own
+    // sizeable surfaces instead: touching hands are split pixel by pixel, which can leave a slot a
+    // sliver of the other hand nearer the camera than its own.
     int best = -1;
     double best_depth = std::numeric_limits<double>::infinity();
     double best_area = 0.0;
