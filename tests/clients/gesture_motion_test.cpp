@@ -14,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdint>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -43,9 +45,14 @@ void collect(handtrack::Gestures& gestures, const handtrack_frame& frame, int ge
   }
 }
 
-// Events of `gesture` from tracked poses and from the ground truth of `motion`.
-std::pair<std::vector<Event>, std::vector<Event>> events_of(const std::string& motion, int gesture, int frames) {
-  synth::SyntheticCamera camera(synth::live_camera_options(motion, kFrames, 1, 60));
+// The subjects (synthetic seeds) whose motions are tracked: one decides nothing (the fists of
+// flexex1 were on time for one subject and late or missed for the two others).
+constexpr std::array<uint64_t, 3> kSubjects = {1, 2, 3};
+
+// Events of `gesture` from tracked poses and from the ground truth of `motion` by subject `seed`.
+std::pair<std::vector<Event>, std::vector<Event>> events_of(const std::string& motion, int gesture, int frames,
+                                                            uint64_t seed = kSubjects[0]) {
+  synth::SyntheticCamera camera(synth::live_camera_options(motion, kFrames, seed, 60));
   Tracker tracker(TrackerConfig{});
   handtrack::Gestures tracked;
   handtrack::Gestures truth;
@@ -83,28 +90,32 @@ std::string describe(const std::vector<Event>& events) {
   return s.empty() ? " none" : s;
 }
 
-// `tolerance` in frames at 60 fps.
+// For every subject: the same events, within `tolerance` frames at 60 fps.
 void expect_same_events(const std::string& motion, int gesture, int frames, int at_least, int tolerance) {
-  const auto [tracked, truth] = events_of(motion, gesture, frames);
-  const std::string what = motion + " / " + handtrack_gesture_name(gesture) + ": tracked" + describe(tracked) +
-                           "; truth" + describe(truth);
-  EXPECT_GE(static_cast<int>(truth.size()), at_least) << what;
-  ASSERT_EQ(tracked.size(), truth.size()) << what;
-  for (size_t i = 0; i < truth.size(); ++i) {
-    EXPECT_EQ(tracked[i].kind, truth[i].kind) << what;
-    EXPECT_LE(std::abs(tracked[i].frame - truth[i].frame), tolerance) << what;
+  for (const uint64_t seed : kSubjects) {
+    const auto [tracked, truth] = events_of(motion, gesture, frames, seed);
+    const std::string what = motion + " s" + std::to_string(seed) + " / " + handtrack_gesture_name(gesture) +
+                             ": tracked" + describe(tracked) + "; truth" + describe(truth);
+    std::cout << what << "\n";
+    EXPECT_GE(static_cast<int>(truth.size()), at_least) << what;
+    ASSERT_EQ(tracked.size(), truth.size()) << what;
+    for (size_t i = 0; i < truth.size(); ++i) {
+      EXPECT_EQ(tracked[i].kind, truth[i].kind) << what;
+      EXPECT_LE(std::abs(tracked[i].frame - truth[i].frame), tolerance) << what;
+    }
   }
-  std::cout << what << "\n";
 }
 
-// Within 200 ms (the first pinch starts 5 frames late while the tracker settles; the others 1-3).
+// Within 200 ms (the first pinch starts 3-8 frames late while the tracker settles; the others 0-3).
 TEST(GestureMotions, EveryPinchOfThePinchMotion) {
   expect_same_events("pinch", HANDTRACK_GESTURE_PINCH, kFrames, 6, 12);
 }
-// Within 330 ms: the tracked fist used to curl more slowly than the true one (the start 16 frames
-// late, the end on time); with the rechecks of a mediocre fit it starts 1 frame early, ends 2 late.
+// Within 500 ms: the tracked fist curls more slowly than the true one, its start 1-26 frames late
+// (its end 4-12 frames early or late) over the three subjects; before the quadtree split cells
+// partly off the hand, the third subject's fist was never closed (docs/TRACKER.md, "The quadtree's
+// outline").
 TEST(GestureMotions, TheFistsOfFlexex1sSlowHalf) {
-  expect_same_events("flexex1", HANDTRACK_GESTURE_GRAB, kFrames / 2, 2, 20);
+  expect_same_events("flexex1", HANDTRACK_GESTURE_GRAB, kFrames / 2, 2, 30);
 }
 
 TEST(GestureMotions, PointingOfFingercountInTheGroundTruth) {

@@ -6,6 +6,8 @@
 #include "handtrack/core/tracker.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -22,13 +24,19 @@ inline TrackerConfig paper_config(EnergyMode mode) {
   return config;
 }
 
-// 320x240, sensor noise on, body background, seed 7: the frames of the accuracy table.
-inline synth::SyntheticCamera motion_camera(std::string_view motion) {
+// The subjects (synthetic seeds: hand size, noise) the tracking tests assert over. One subject
+// decides nothing: a change to the image mixture moves single sequences by tens of millimetres
+// either way, and a test of one seed passed or failed by the subject it happened to use
+// (docs/TRACKER.md, "Clean depth"). So the tests assert shares and means over three.
+inline constexpr std::array<uint64_t, 3> kSubjectSeeds = {7, 8, 9};
+
+// 320x240, sensor noise on, body background: the frames of the accuracy table.
+inline synth::SyntheticCamera motion_camera(std::string_view motion, uint64_t seed = kSubjectSeeds[0]) {
   synth::SynthOptions options;
   options.motion = std::string(motion);
   options.frames = kSequenceFrames;
   options.noise = true;
-  options.seed = 7;
+  options.seed = seed;
   return synth::SyntheticCamera(options);
 }
 

@@ -1,10 +1,11 @@
 // The accuracy tests of issues 2 and 4: the seven synthetic Dexter-1-like motions (300 frames each,
-// 320x240, sensor noise on) tracked with 2 particles x 10 iterations (Sec. 7's configuration),
-// depth-only and with late fusion (Sec. 5, the shipped part forest), both on the same rendered
-// frames. Asserts what a user would notice: the mean fingertip error, that late fusion is not less
-// accurate than depth-only on any motion, NaN-free poses, and that no sequence is lost for good.
-// Those two run the paper's energy (eq. 2, w_f = 0); the shipped late fusion, with our free-space
-// term E_free, runs on the same frames against issue "Every view"'s goal for these motions.
+// 320x240, sensor noise on) of three subjects (testing::kSubjectSeeds) tracked with 2 particles x
+// 10 iterations (Sec. 7's configuration), depth-only and with late fusion (Sec. 5, the shipped part
+// forest), both on the same rendered frames. Asserts what a user would notice: the mean fingertip
+// error, that late fusion is not less accurate than depth-only on any motion (over the subjects),
+// NaN-free poses, and that sequences lost for good are rare. Those two run the paper's energy
+// (eq. 2, w_f = 0); the shipped late fusion, with our free-space term E_free, runs on the same
+// frames against issue "Every view"'s goal for these motions (the mean over 3 seeds).
 #include "synthetic_tracking.hpp"
 
 #include "handtrack/eval/scoring.hpp"
@@ -14,6 +15,8 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 namespace handtrack {
 namespace {
@@ -22,24 +25,50 @@ using testing::kSequenceFrames;
 
 constexpr double kMaxDepthOnlyMeanMm = 25.0;    // issue 2, "Done when"
 constexpr double kMaxLateFusionMeanMm = 15.0;   // issue 4, "Done when"
-constexpr double kMaxShippedMeanMm = 10.0;      // issue "Every view", "Done when" (there: 3 seeds)
-// Late fusion may be this much worse than depth-only on one motion and still count as "not worse".
-// Why not 0: the particles draw random extrapolation factors, and another draw alone moves a
-// motion's mean: depth-only with seeds 1-3 gives pinch 5.12-5.95 mm, fingerwave 6.76-9.17 mm,
-// fingercount 12.6-18.8 mm (docs/TRACKER.md, "Late fusion"). 1 mm is above the spread of the easy
-// motions and far below the gains late fusion must show on the closed hands (flexex1 -9 mm).
+constexpr double kMaxShippedMeanMm = 10.0;      // issue "Every view", "Done when": over 3 seeds
+// Late fusion may be this much worse than depth-only on one motion (its mean over the subjects)
+// and still count as "not worse". Why not 0: the particles draw random extrapolation factors, and
+// another draw alone moves a motion's mean: depth-only with seeds 1-3 gives pinch 5.12-5.95 mm,
+// fingerwave 6.76-9.17 mm, fingercount 12.6-18.8 mm (docs/TRACKER.md, "Late fusion"). 1 mm is above
+// the spread of the easy motions and far below the gains late fusion must show on the closed hands
+// (flexex1 -9 mm).
 constexpr double kNotWorseToleranceMm = 1.0;
-// "Lost for good": at the end of a sequence the tracker must be back on the hand: at least half of
-// the last 60 frames under 30 mm.
+// "Lost for good": at the end of a sequence the tracker is not back on the hand: fewer than half
+// of the last 60 frames under 30 mm. At most one sequence of the 21 (7 motions x 3 subjects) of
+// each energy: the fast `random` of one subject or another is lost near its end by depth-only
+// tracking and by the paper's late fusion (docs/TRACKER.md, "The quadtree's outline").
 constexpr int kTailFrames = 60;
 constexpr double kTailBoundMm = 30.0;
+constexpr int kMostLostForGood = 1;
 
-void expect_sane(const eval::SequenceScore& s, const char* energy) {
-  EXPECT_EQ(s.nan_poses, 0) << energy << " " << s.name;
-  EXPECT_EQ(s.without_pose, 0) << energy << " " << s.name << ": the hand is always in view";
+bool lost_for_good(const eval::SequenceScore& s) {
   const auto tail_begin = s.per_frame_error_mm.end() - kTailFrames;
   const auto good = std::count_if(tail_begin, s.per_frame_error_mm.end(), [](double e) { return e < kTailBoundMm; });
-  EXPECT_GE(good, kTailFrames / 2) << energy << " " << s.name << " is lost for good";
+  return good < kTailFrames / 2;
+}
+
+// Every pose finite and every frame posed (the hand is always in view); returns how many sequences
+// were lost for good, naming each.
+int expect_sane(const std::vector<eval::SequenceScore>& scores, const char* energy) {
+  int lost = 0;
+  for (const auto& s : scores) {
+    EXPECT_EQ(s.nan_poses, 0) << energy << " " << s.name;
+    EXPECT_EQ(s.without_pose, 0) << energy << " " << s.name << ": the hand is always in view";
+    if (lost_for_good(s)) {
+      std::printf("%s: %s is lost for good\n", energy, s.name.c_str());
+      ++lost;
+    }
+  }
+  return lost;
+}
+
+// The mean error of each motion over the subjects, in kMotionNames' order (`scores` holds the
+// subjects one after the other, each the seven motions in that order).
+std::vector<double> motion_means(const std::vector<eval::SequenceScore>& scores) {
+  std::vector<double> means(synth::kMotionNames.size(), 0.0);
+  for (size_t k = 0; k < scores.size(); ++k) means[k % means.size()] += scores[k].mean_error_mm;
+  for (double& m : means) m /= static_cast<double>(testing::kSubjectSeeds.size());
+  return means;
 }
 
 TEST(TrackingAccuracy, SevenSyntheticMotionsDepthOnlyAndLateFusion2Particles10Iterations) {
@@ -49,24 +78,27 @@ TEST(TrackingAccuracy, SevenSyntheticMotionsDepthOnlyAndLateFusion2Particles10It
   std::vector<eval::SequenceScore> shipped;
   TrackerConfig paper_fusion = testing::paper_config(EnergyMode::kLateFusion);
   paper_fusion.weights.free_space = 0.0;
-  for (const auto motion : synth::kMotionNames) {
-    auto camera = testing::motion_camera(motion);
-    Tracker depth_tracker(testing::paper_config(EnergyMode::kDepthOnly));
-    Tracker fusion_tracker(paper_fusion);
-    Tracker shipped_tracker(testing::paper_config(EnergyMode::kLateFusion));
-    eval::SequenceScorer depth_scorer{std::string(motion)};
-    eval::SequenceScorer fusion_scorer{std::string(motion)};
-    eval::SequenceScorer shipped_scorer{std::string(motion)};
-    synth::SynthFrame frame;
-    for (int i = 0; i < kSequenceFrames; ++i) {
-      camera.render(i, frame);
-      depth_scorer.add(depth_tracker.track(frame.depth), frame.fingertips);
-      fusion_scorer.add(fusion_tracker.track(frame.depth, &forest), frame.fingertips);
-      shipped_scorer.add(shipped_tracker.track(frame.depth, &forest), frame.fingertips);
+  for (const uint64_t seed : testing::kSubjectSeeds) {
+    for (const auto motion : synth::kMotionNames) {
+      auto camera = testing::motion_camera(motion, seed);
+      Tracker depth_tracker(testing::paper_config(EnergyMode::kDepthOnly));
+      Tracker fusion_tracker(paper_fusion);
+      Tracker shipped_tracker(testing::paper_config(EnergyMode::kLateFusion));
+      const std::string name = std::string(motion) + "-s" + std::to_string(seed);
+      eval::SequenceScorer depth_scorer{name};
+      eval::SequenceScorer fusion_scorer{name};
+      eval::SequenceScorer shipped_scorer{name};
+      synth::SynthFrame frame;
+      for (int i = 0; i < kSequenceFrames; ++i) {
+        camera.render(i, frame);
+        depth_scorer.add(depth_tracker.track(frame.depth), frame.fingertips);
+        fusion_scorer.add(fusion_tracker.track(frame.depth, &forest), frame.fingertips);
+        shipped_scorer.add(shipped_tracker.track(frame.depth, &forest), frame.fingertips);
+      }
+      depth_only.push_back(depth_scorer.finish(0.0));
+      late_fusion.push_back(fusion_scorer.finish(0.0));
+      shipped.push_back(shipped_scorer.finish(0.0));
     }
-    depth_only.push_back(depth_scorer.finish(0.0));
-    late_fusion.push_back(fusion_scorer.finish(0.0));
-    shipped.push_back(shipped_scorer.finish(0.0));
   }
   const auto depth_total = eval::overall(depth_only);
   const auto fusion_total = eval::overall(late_fusion);
@@ -77,14 +109,18 @@ TEST(TrackingAccuracy, SevenSyntheticMotionsDepthOnlyAndLateFusion2Particles10It
 
   EXPECT_LE(depth_total.mean_error_mm, kMaxDepthOnlyMeanMm);
   EXPECT_LE(fusion_total.mean_error_mm, kMaxLateFusionMeanMm);
-  for (size_t k = 0; k < depth_only.size(); ++k) {
-    expect_sane(depth_only[k], "depth-only");
-    expect_sane(late_fusion[k], "late fusion");
-    EXPECT_LE(late_fusion[k].mean_error_mm, depth_only[k].mean_error_mm + kNotWorseToleranceMm)
-        << late_fusion[k].name << ": late fusion less accurate than depth-only";
-    expect_sane(shipped[k], "shipped late fusion");
-  }
   EXPECT_LE(shipped_total.mean_error_mm, kMaxShippedMeanMm);
+  EXPECT_LE(expect_sane(depth_only, "depth-only"), kMostLostForGood);
+  EXPECT_LE(expect_sane(late_fusion, "late fusion"), kMostLostForGood);
+  EXPECT_EQ(expect_sane(shipped, "shipped late fusion"), 0);
+  const auto depth_means = motion_means(depth_only);
+  const auto fusion_means = motion_means(late_fusion);
+  for (size_t m = 0; m < synth::kMotionNames.size(); ++m) {
+    std::printf("%-12s over the subjects: depth-only %.2f mm, late fusion %.2f mm\n",
+                std::string(synth::kMotionNames[m]).c_str(), depth_means[m], fusion_means[m]);
+    EXPECT_LE(fusion_means[m], depth_means[m] + kNotWorseToleranceMm)
+        << synth::kMotionNames[m] << ": late fusion less accurate than depth-only";
+  }
   // Late fusion must be more than one depth-only particle: the detection-guided one has to win.
   EXPECT_GT(fusion_total.guided_wins, 0);
 }
