@@ -1,6 +1,9 @@
 // Every view (issue "Every hand, every view"): the shipped configuration (late fusion with the
 // shipped forest, handedness auto, 2 particles x 10 iterations) on one motion in each camera
-// arrangement of handtrack-synth, 120 frames, one seed not used while tuning (21), noise on.
+// arrangement of handtrack-synth, 120 frames, three subjects not used while tuning (seeds 21-23),
+// noise on. A bound holds for the three pooled: one subject decides nothing (the quadtree's split of
+// the outline moved fingers-away left of seed 21 from 11.2 to 25.2 mm while the broadened benchmark
+// gained 0.7-0.8 mm; docs/TRACKER.md, "The quadtree's outline").
 //
 // The bounds are what the tracker reaches now with some room, so that a change that loses a view
 // fails here; they are not the issue's goal (every view <= 20 mm, handedness >= 98 %), which the
@@ -13,6 +16,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -20,7 +25,7 @@ namespace handtrack {
 namespace {
 
 constexpr int kFrames = 120;
-constexpr uint64_t kSeed = 21;
+constexpr std::array<uint64_t, 3> kSeeds = {21, 22, 23};
 
 struct ViewCase {
   synth::View view;
@@ -32,7 +37,7 @@ struct ViewCase {
   const char* motion = "pinch";
 };
 
-testing::OneHandRun track_view(const ViewCase& c, const PartForest& forest, uint64_t seed = kSeed) {
+testing::OneHandRun track_view(const ViewCase& c, const PartForest& forest, uint64_t seed) {
   synth::SynthOptions options;
   options.motion = c.motion;
   options.frames = kFrames;
@@ -46,19 +51,38 @@ testing::OneHandRun track_view(const ViewCase& c, const PartForest& forest, uint
   return testing::track_one_hand(options, config, &forest);
 }
 
+// `c` tracked for each of `seeds`, pooled (the mean over every posed frame), each printed.
+template <typename Seeds>
+testing::OneHandRun track_subjects(const ViewCase& c, const PartForest& forest, const Seeds& seeds) {
+  testing::OneHandRun pooled;
+  double error_sum_mm = 0.0;
+  for (const uint64_t seed : seeds) {
+    const testing::OneHandRun run = track_view(c, forest, seed);
+    std::printf("%s %s %s seed %llu: %.1f mm, %d of %d frames posed, %d as the hand shown\n", c.motion,
+                std::string(synth::view_name(c.view)).c_str(), std::string(synth::handedness_name(c.hand)).c_str(),
+                static_cast<unsigned long long>(seed), run.mean_error_mm, run.posed, kFrames, run.reported_as_shown);
+    pooled.posed += run.posed;
+    pooled.reported_as_shown += run.reported_as_shown;
+    error_sum_mm += run.mean_error_mm * run.posed;
+  }
+  pooled.mean_error_mm = pooled.posed > 0 ? error_sum_mm / pooled.posed : 1e9;
+  return pooled;
+}
+
 class EveryView : public ::testing::TestWithParam<ViewCase> {};
 
 TEST_P(EveryView, TrackedAsTheHandItIs) {
   const ViewCase& c = GetParam();
   const PartForest forest = PartForest::load(shipped_forest_path().value());
-  const testing::OneHandRun run = track_view(c, forest);
+  const testing::OneHandRun run = track_subjects(c, forest, kSeeds);
   const std::string name = std::string(c.motion) + " " + std::string(synth::view_name(c.view)) + " " +
                            std::string(synth::handedness_name(c.hand)) +
                            " on " + std::string(synth::background_name(c.background)) +
                            (c.ball_radius_mm > 0.0 ? " holding a ball" : "");
+  const int frames = kFrames * static_cast<int>(kSeeds.size());
   std::printf("%s: %.1f mm, %d of %d frames posed, %d as the hand shown\n", name.c_str(), run.mean_error_mm, run.posed,
-              kFrames, run.reported_as_shown);
-  EXPECT_GE(run.posed, kFrames * 95 / 100) << name << ": a pose in at least 95 % of the frames";
+              frames, run.reported_as_shown);
+  EXPECT_GE(run.posed, frames * 95 / 100) << name << ": a pose in at least 95 % of the frames";
   EXPECT_LE(run.mean_error_mm, c.max_mean_mm) << name;
   EXPECT_GE(run.reported_as_shown, c.min_handedness_share * run.posed) << name << ": handedness";
 }
@@ -86,7 +110,11 @@ std::string case_name(const ::testing::TestParamInfo<ViewCase>& info) {
 // from 30 to 20 mm and raised from 60 to 80 %), the other views unchanged. With the forest
 // retrained with held balls and the regions it calls background dropped: palm 4.2 / 4.7, back 10.9
 // (100 %), side 7.1, fingers-toward 8.3, fingers-away 11.2, head-mounted 28.5 mm; on a desk 5.8,
-// 7.2, 11.6 mm.
+// 7.2, 11.6 mm. Over seeds 21-23 pooled, with the quadtree's outline split (2026-11-26): palm 5.0 /
+// 4.5, back 16.6 mm (83 % the right hand; seed 22 48 %), side 6.5, fingers-toward 7.1,
+// fingers-away 16.0, head-mounted 29.9 mm; on a desk 5.3, 7.0, 18.3 mm (the back 76 % the right
+// hand, seed 22 41 %: its bound lowered from 90 to 70 %, what seed 21 alone had set); holding a
+// ball 12.6 mm.
 INSTANTIATE_TEST_SUITE_P(
     ShippedConfiguration, EveryView,
     ::testing::Values(ViewCase{synth::View::kPalm, synth::Handedness::kRight, 12.0, 0.98},
@@ -106,7 +134,7 @@ INSTANTIATE_TEST_SUITE_P(
     OnADesk, EveryView,
     ::testing::Values(ViewCase{synth::View::kPalm, synth::Handedness::kRight, 12.0, 0.98, synth::Background::kDesk},
                       ViewCase{synth::View::kSide, synth::Handedness::kLeft, 15.0, 0.98, synth::Background::kDesk},
-                      ViewCase{synth::View::kBack, synth::Handedness::kRight, 25.0, 0.9, synth::Background::kDesk}),
+                      ViewCase{synth::View::kBack, synth::Handedness::kRight, 25.0, 0.7, synth::Background::kDesk}),
     case_name);
 
 // A ball (35 mm radius) held against the palm: segmentation keeps it with the hand (it touches the
@@ -127,20 +155,16 @@ INSTANTIATE_TEST_SUITE_P(HoldingABall, EveryView,
 // of 960 (45 %), 19.3 mm.
 TEST(FlatHandFromTheBack, MostFramesAreTheHandItIs) {
   const PartForest forest = PartForest::load(shipped_forest_path().value());
+  constexpr std::array<uint64_t, 4> kFlatSeeds = {21, 22, 23, 24};
   int posed = 0;
   int as_shown = 0;
   double error_sum_mm = 0.0;
   for (const synth::Handedness hand : {synth::Handedness::kRight, synth::Handedness::kLeft}) {
-    for (uint64_t seed = 21; seed <= 24; ++seed) {
-      const ViewCase flat{synth::View::kBack, hand, 0.0, 0.0, synth::Background::kBody, 0.0, "adbadd"};
-      const testing::OneHandRun run = track_view(flat, forest, seed);
-      std::printf("adbadd back %s seed %llu: %.1f mm, %d of %d frames as the hand shown\n",
-                  std::string(synth::handedness_name(hand)).c_str(), static_cast<unsigned long long>(seed),
-                  run.mean_error_mm, run.reported_as_shown, run.posed);
-      posed += run.posed;
-      as_shown += run.reported_as_shown;
-      error_sum_mm += run.mean_error_mm * run.posed;
-    }
+    const ViewCase flat{synth::View::kBack, hand, 0.0, 0.0, synth::Background::kBody, 0.0, "adbadd"};
+    const testing::OneHandRun run = track_subjects(flat, forest, kFlatSeeds);
+    posed += run.posed;
+    as_shown += run.reported_as_shown;
+    error_sum_mm += run.mean_error_mm * run.posed;
   }
   EXPECT_GE(as_shown, 0.7 * posed) << as_shown << " of " << posed << " frames reported as the hand shown";
   EXPECT_LE(error_sum_mm / posed, 17.0);
