@@ -65,14 +65,9 @@ void QuadtreeBuilder::quad(int x, int y, int side) {
   const int count = node.count;
   if (count == 0) return;
   const int area = (xe - x) * (ye - y);
-  // Sec. 3.1: a quad is a region of homogeneous depth. A pixel off the hand is a jump in depth, so a
-  // cell partly off the hand is split like a steep one, down to the smallest cell, where
-  // min_leaf_fill decides. Kept whole, a 16-32 px cell half on a finger put its Gaussian at its
-  // centre, up to a quarter of the cell off the finger; noise-free depth, whose outlines split no
-  // cell by themselves, lost most (docs/TRACKER.md, "Clean depth").
   const bool full_enough = count >= config_->min_leaf_fill * area;
-  const bool homogeneous = count == area && node.hi - node.lo < config_->quadtree_threshold_mm;
-  if (side > cells_.side && !homogeneous) {
+  const bool flat = node.hi - node.lo < config_->quadtree_threshold_mm;
+  if (side > cells_.side && !(flat && full_enough)) {
     const int half = side / 2;
     quad(x, y, half);
     quad(x + half, y, half);

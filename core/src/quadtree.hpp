@@ -1,9 +1,8 @@
 #pragma once
-// The quadtree over the segmented hand (paper Sec. 3.1): cells are split until each is a region of
-// homogeneous depth, all hand and with a depth range below epsilon_c, or the smallest cell; every
-// leaf full enough of hand pixels (min_leaf_fill, which only the smallest cells can miss) becomes a
-// unit-weight 2D Gaussian with sigma = a / sqrt(2) and the mean depth of its pixels, labelled by the
-// majority part label of its pixels (Sec. 4.3). Private to core (DepthInputBuilder).
+// The quadtree over the segmented hand (paper Sec. 3.1): cells are split until the depth range of
+// their hand pixels is below epsilon_c; every leaf full enough of hand pixels becomes a unit-weight
+// 2D Gaussian with sigma = a / sqrt(2) and the mean depth of its pixels, labelled by the majority
+// part label of its pixels (Sec. 4.3). Private to core (DepthInputBuilder).
 #include "hand_segmentation.hpp"
 
 #include "handtrack/core/depth_input.hpp"

@@ -31,10 +31,10 @@ struct DepthInputConfig {
   int median_radius_px = 1;             // 3x3 median "to remove flying pixels" (Sec. 4)
   double near_mm = 150.0;               // working volume, Sec. 4: "between 150 mm and 600 mm"
   double far_mm = 600.0;
-  double quadtree_threshold_mm = 20.0;  // epsilon_c, Sec. 3.1: split until max - min < 20 mm (and all hand)
+  double quadtree_threshold_mm = 20.0;  // epsilon_c, Sec. 3.1: split until max - min < 20 mm
   int quadtree_root_px = 32;            // root cell side at 320 px image width (scales with width)
   int quadtree_min_leaf_px = 2;         // smallest cell at 320 px width (scales with width)
-  double min_leaf_fill = 0.5;           // a smallest cell must be at least this full of hand pixels
+  double min_leaf_fill = 0.5;           // a leaf must be at least this full of hand pixels
   double continuity_mm = 25.0;          // neighbouring pixels closer than this are one surface
   double min_hand_area_mm2 = 1500.0;    // smaller blobs are noise, not a hand
   double hand_length_mm = 190.0;        // wrist to middle fingertip, bounds the hand region
