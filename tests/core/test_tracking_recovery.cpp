@@ -95,8 +95,7 @@ std::vector<int> knock_off_and_track(std::string_view motion, const TrackerConfi
 // off after each of kKnockFrames: of the 63 knocks at least 95 % must be back within 30 frames.
 // Measured on the first subject when the check came: all 21 knocks repaired, 20 within 2 frames
 // (docs/TRACKER.md, "Recovery"; before the check, 14 of 21). Over three subjects (2026-11-26): 62 of
-// 63 back (random of subject 9 knocked off after frame 140 is not: it settles 20-25 mm off and is
-// back after 33 frames).
+// 63 back (not: random of subject 9 knocked off after frame 140).
 constexpr int kMostKnocksNotBack = 3;
 
 TEST(TrackingRecovery, BackWithin30FramesAfterAGrossError) {
