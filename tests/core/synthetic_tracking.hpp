@@ -42,11 +42,19 @@ inline synth::SyntheticCamera motion_camera(std::string_view motion, uint64_t se
 
 // One rendered hand tracked by a Tracker (every frame), scored from frame `from_frame` on: the mean
 // fingertip error over the scored frames with a pose, how many had one, and how many of those were
-// reported as the hand shown.
+// reported as the hand shown. Runs of several subjects pool with add(): the mean is then over
+// every posed frame of them all.
 struct OneHandRun {
-  double mean_error_mm = 0.0;
+  double error_sum_mm = 0.0;  // the frames' mean fingertip errors, summed over the posed frames
   int posed = 0;
   int reported_as_shown = 0;
+
+  [[nodiscard]] double mean_error_mm() const { return posed > 0 ? error_sum_mm / posed : 1e9; }
+  void add(const OneHandRun& other) {
+    error_sum_mm += other.error_sum_mm;
+    posed += other.posed;
+    reported_as_shown += other.reported_as_shown;
+  }
 };
 
 inline OneHandRun track_one_hand(const synth::SynthOptions& options, const TrackerConfig& config,
@@ -55,7 +63,6 @@ inline OneHandRun track_one_hand(const synth::SynthOptions& options, const Track
   Tracker tracker(config);
   const Handedness shown = options.hand == synth::Handedness::kLeft ? Handedness::kLeft : Handedness::kRight;
   OneHandRun run;
-  double sum = 0.0;
   synth::SynthFrame frame;
   for (int i = 0; i < options.frames; ++i) {
     camera.render(i, frame);
@@ -65,9 +72,8 @@ inline OneHandRun track_one_hand(const synth::SynthOptions& options, const Track
     run.reported_as_shown += out.handedness == shown ? 1 : 0;
     double e = 0.0;
     for (size_t t = 0; t < kNumFingers; ++t) e += (out.fingertips[t] - *frame.fingertips[t]).norm();
-    sum += e / kNumFingers;
+    run.error_sum_mm += e / kNumFingers;
   }
-  run.mean_error_mm = run.posed > 0 ? sum / run.posed : 1e9;
   return run;
 }
 

@@ -49,7 +49,7 @@ TEST_P(SyntheticHands, TrackedAndReportedAsTheHandTheyAre) {
   const auto& [motion, hand, seed] = GetParam();
   const testing::OneHandRun run = track_synthetic(motion, hand, seed);
   EXPECT_GE(run.posed, 114) << "a pose in at least 95 % of the frames";
-  EXPECT_LE(run.mean_error_mm, 12.0);
+  EXPECT_LE(run.mean_error_mm(), 12.0);
   EXPECT_GE(run.reported_as_shown, static_cast<int>(0.98 * run.posed))
       << run.reported_as_shown << " of " << run.posed << " frames reported as the " << synth::handedness_name(hand)
       << " hand";
