@@ -1,5 +1,7 @@
 #include "handtrack/core/tracker.hpp"
 
+#include "background_search.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -12,52 +14,12 @@ namespace handtrack {
 using Eigen::Vector3d;
 
 namespace {
-// (Re)start hypotheses: the open hand of Sec. 5 and, since a hand often enters or is lost as a
-// fist, a closed hand; each turned by a few in-plane rotations (rad) around the segmented axis.
-constexpr std::array<double, 3> kStartRotations = {0.0, 0.4, -0.4};
-constexpr std::array<bool, 2> kStartClosed = {false, true};
-// ... each with the palm toward the camera, the back of the hand, and either edge (the thumb's,
-// the little finger's): turned about the hand's finger axis (rad). Without the edges a hand seen
-// side-on was fitted as a flattened hand of the other side (docs/TRACKER.md, "Every view").
-constexpr std::array<double, 4> kStartTurns = {0.0, std::numbers::pi, 0.5 * std::numbers::pi,
-                                               -0.5 * std::numbers::pi};
-// (Re)start search by successive halving (PoseTracker::restart): every hypothesis gets this many
-// iterations first, and only the best few the rest of TrackerConfig::init_iterations.
-constexpr int kScreenIterations = 15;
-constexpr size_t kRefinedStarts = 3;
-// Hypotheses in one plane (the image's or along the 3D axis): turns x closed x rotations; at most
-// two planes.
-constexpr size_t kStartsPerPlane = kStartTurns.size() * kStartClosed.size() * kStartRotations.size();
-constexpr size_t kMaxStarts = 2 * kStartsPerPlane;
-// A hand whose segmented axis points this much toward or away from the camera (|a_z|, the sine of
-// the angle out of the image plane: 45 deg) is also started with its fingers along that axis in 3D:
-// a hand reaching forward under a head-mounted camera, fingers pointing at a desk camera.
-constexpr double kOutOfPlaneAxisMinZ = 0.7;
-// Closed hand: [abd, flex1, flex2, flex3] for the thumb, then for each finger.
-constexpr std::array<double, 4> kClosedThumb = {0.3, 0.6, 0.5, 0.5};
-constexpr std::array<double, 4> kClosedFinger = {0.0, 1.3, 1.5, 0.9};
-constexpr double kClosedFingersInFrontMm = 40.0;
 // A hand lost during a handedness trial (Tracker::optimise) is (re)started again every this many
 // frames: on every frame, a hand that found no start made each trial frame cost a whole search
 // (a pipeline frame 9-10 ms instead of 1.5).
 constexpr int kTrialRestartFrames = 5;
 // Pinch strength falls from 1 (tips touching) to 0 at this surface distance.
 constexpr double kPinchOpenMm = 40.0;
-
-// confidence(): the share of the hand's data explained by the fitted model, times the share of
-// model Gaussians that sit on data. Not from the paper: set with the recovery check of issue 4
-// (docs/TRACKER.md "Recovery") and kept since.
-// A model Gaussian whose centre is nearer the camera than this is behind it (cannot project).
-constexpr double kMinProjectableDepthMm = 1.0;
-// A data leaf is explained by a model Gaussian that covers it in the image and whose surface is
-// within this depth of the leaf: kExplainSigmas model sigmas plus kExplainMarginMm of noise.
-constexpr double kExplainSigmas = 2.0;
-constexpr double kExplainMarginMm = 10.0;
-// A model Gaussian "floats" (counts against the fit) when the data under its centre is missing or
-// farther than its surface by more than kFloatSigmas sigmas plus kFloatMarginMm; data nearer the
-// camera merely occludes it.
-constexpr double kFloatSigmas = 3.0;
-constexpr double kFloatMarginMm = 20.0;
 
 // The value among `values` whose to_string() is `text`.
 template <typename Enum>
@@ -71,10 +33,6 @@ bool parse_name(const std::string& text, std::initializer_list<Enum> values, Enu
   return false;
 }
 }  // namespace
-
-double fit_score(double confidence, double label_agreement) {
-  return label_agreement < 0.0 ? confidence : confidence * label_agreement;
-}
 
 double TrackerOutput::score() const { return fit_score(confidence, label_agreement); }
 
@@ -163,6 +121,12 @@ void TrackerInputs::build(const DepthImage& depth, const InputRequest& request, 
 
 namespace {
 Handedness opposite(Handedness hand) { return hand == Handedness::kLeft ? Handedness::kRight : Handedness::kLeft; }
+
+// The latency settings: a check's search spread over frames or made in the background, so that no
+// tracked frame runs a whole search (TrackerConfig::check_iterations_per_frame, background_checks).
+bool checks_off_the_frame(const TrackerConfig& config) {
+  return config.check_iterations_per_frame > 0 || config.background_checks;
+}
 }  // namespace
 
 Tracker::Tracker(const TrackerConfig& config)
@@ -200,8 +164,8 @@ InputRequest Tracker::request() const {
   return r;
 }
 
-TrackerOutput Tracker::fit(Handedness hand, const DepthInput& input, PoseTracker::CheckPace pace) {
-  TrackerOutput out = side(hand).optimise(input, pace);
+TrackerOutput Tracker::fit(Handedness hand, const DepthInput& input) {
+  TrackerOutput out = side(hand).optimise(input);
   if (hand == Handedness::kLeft) {
     mirror_output(out);
     out.handedness = Handedness::kLeft;
@@ -321,11 +285,12 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
     // A trial: both hands, each from its history or its (re)start hypotheses; each hand's
     // suspect-fit checks go at the configured pace, as when it tracks alone. A hand lost later in
     // the trial scores 0 and is (re)started again every kTrialRestartFrames frames, a whole search
-    // on one frame (10-16 ms), except with checks spread over frames (the latency setting: no
-    // tracked frame runs a whole search), where it is not. Never (re)started, the true hand that
-    // found no start on a fist was lost for good: fingercount 37.2 -> 45.1 mm, handedness 77 -> 60 %.
-    const bool spread = config().check_iterations_per_frame > 0;
-    const bool restarts = trial_frames_ == 0 || (!spread && trial_frames_ % kTrialRestartFrames == 0);
+    // on one frame (10-16 ms), except with checks spread over frames or in the background (the
+    // latency settings: no tracked frame runs a whole search), where it is not. Never (re)started,
+    // the true hand that found no start on a fist was lost for good: fingercount 37.2 -> 45.1 mm,
+    // handedness 77 -> 60 %.
+    const bool restarts =
+        trial_frames_ == 0 || (!checks_off_the_frame(config()) && trial_frames_ % kTrialRestartFrames == 0);
     const auto trial_fit = [&](Handedness hand, const DepthInput& input) {
       return side(hand).lost() && !restarts ? TrackerOutput{} : fit(hand, input);
     };
@@ -357,9 +322,9 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
   } else if (config().handedness == HandednessMode::kAuto && !both()) {
     // A hand chosen by a trial and tracked alone since: put to a trial again while its fit stays
     // mediocre (TrackerConfig::handedness_recheck_frames). Its first frame is a whole (re)start
-    // search of the other hand, which the latency setting (checks spread over frames) makes on no
-    // tracked frame: there, none.
-    const int every = config().check_iterations_per_frame > 0 ? 0 : config().handedness_recheck_frames;
+    // search of the other hand, which the latency settings (checks spread over frames or in the
+    // background) make on no tracked frame: there, none.
+    const int every = checks_off_the_frame(config()) ? 0 : config().handedness_recheck_frames;
     if (every > 0 && ++frames_since_trial_ >= every && side(current_).mediocre()) {
       trial_pending_ = true;
       retrial_ = true;
@@ -378,16 +343,14 @@ TrackerOutput Tracker::track(const DepthImage& depth, const PixelLabeller* label
   return optimise(inputs_);
 }
 
-namespace {
-// The weights of `config`'s energies: E_free (w_f) only with late fusion. Depth-only tracking runs
-// the paper's eq. 2: with E_free it lost the fists of fingercount and the fast half of random (the
-// palm-view Dexter motions, 7 subjects: 13.2 -> 17.2 mm; docs/TRACKER.md "Free space").
+// Depth-only tracking runs the paper's eq. 2: with E_free it lost the fists of fingercount and the
+// fast half of random (the palm-view Dexter motions, 7 subjects: 13.2 -> 17.2 mm; docs/TRACKER.md
+// "Free space").
 EnergyWeights mode_weights(const TrackerConfig& config) {
   EnergyWeights weights = config.weights;
   if (config.mode == EnergyMode::kDepthOnly) weights.free_space = 0.0;
   return weights;
 }
-}  // namespace
 
 DepthInputConfig input_config(const TrackerConfig& config) {
   DepthInputConfig input = config.input;
@@ -397,18 +360,19 @@ DepthInputConfig input_config(const TrackerConfig& config) {
 
 PoseTracker::PoseTracker(TrackerConfig config)
     : config_(config),
-      model_(HandModel::default_adult(config.scale)),
-      energy_(SimilarityFactor::kDepth, mode_weights(config)),
-      guided_energy_(SimilarityFactor::kDepthAndLabel, mode_weights(config)),
+      search_(config),
       common_energy_(SimilarityFactor::kDepthAndLabel, mode_weights(config), config.fusion_label_weight),
       optimizer_(config.optimizer),
-      rng_(config.seed) {
-  screened_.reserve(kMaxStarts);
-}
+      background_(config.background_checks ? std::make_unique<BackgroundSearch>(config) : nullptr),
+      rng_(config.seed) {}
+
+PoseTracker::~PoseTracker() = default;
+PoseTracker::PoseTracker(PoseTracker&&) noexcept = default;
+PoseTracker& PoseTracker::operator=(PoseTracker&&) noexcept = default;
 
 void PoseTracker::set_scale(const HandScale& scale) {
   config_.scale = scale;
-  model_ = HandModel::default_adult(scale);
+  search_.set_scale(scale);
 }
 
 void PoseTracker::reset() {
@@ -418,6 +382,7 @@ void PoseTracker::reset() {
   confidence_level_ = 0.0;
   next_check_ = CheckCause::kNone;
   check_ = {};
+  if (background_) background_->cancel();
   frames_since_check_ = 0;
 }
 
@@ -425,22 +390,11 @@ void PoseTracker::override_pose(const PoseParams& pose) {
   previous_ = pose;
   before_previous_ = pose;
   check_ = {};
+  if (background_) background_->cancel();
 }
 
-PoseTracker::Start PoseTracker::start_at(size_t k) {
-  // Hypothesis k: by plane (the image's, then along the 3D axis), turn, closed, and in-plane
-  // rotation, the last changing fastest.
-  const size_t in_plane = k % kStartsPerPlane;
-  Start start;
-  start.along_axis_3d = k >= kStartsPerPlane;
-  start.turn_rad = kStartTurns[in_plane / (kStartClosed.size() * kStartRotations.size())];
-  start.closed = kStartClosed[(in_plane / kStartRotations.size()) % kStartClosed.size()];
-  start.in_plane_offset_rad = kStartRotations[in_plane % kStartRotations.size()];
-  return start;
-}
-
-size_t PoseTracker::start_count(const HandPlace& place) {
-  return std::abs(place.finger_axis.z()) >= kOutOfPlaneAxisMinZ ? kMaxStarts : kStartsPerPlane;
+void PoseTracker::wait_for_check() {
+  if (background_) background_->wait();
 }
 
 std::optional<HandHint> PoseTracker::hint() const {
@@ -449,128 +403,10 @@ std::optional<HandHint> PoseTracker::hint() const {
   // Only the global transform matters (no PosedHand: nothing is allocated on the hot path).
   const Vector3d t = previous_->segment<3>(kTranslationParam);
   const Eigen::Matrix3d camera_R_hand = hand_rotation(*previous_);
-  return HandHint{t + camera_R_hand * model_.palm_centre(), t, camera_R_hand * Vector3d::UnitY()};
+  return HandHint{t + camera_R_hand * model().palm_centre(), t, camera_R_hand * Vector3d::UnitY()};
 }
 
-PoseParams PoseTracker::initial_pose(const HandPlace& place, const Start& start) const {
-  // Frontal open hand (r = 0: fingers toward -y in the image) turned in the image plane onto the
-  // hand's axis: rotation phi about the camera z maps (0,-1) to (sin phi, -cos phi). The back of
-  // the hand faces the camera after half a turn about the finger axis (the camera y axis at r = 0)
-  // first: R = Rz(phi) Ry(pi).
-  const Vector3d& axis = place.finger_axis;
-  const double phi = std::atan2(axis.x(), -axis.y()) + start.in_plane_offset_rad;
-  PoseParams params = PoseParams::Zero();
-  Eigen::Matrix3d turn = Eigen::AngleAxisd(phi, Vector3d::UnitZ()).toRotationMatrix() *
-                         Eigen::AngleAxisd(start.turn_rad, Vector3d::UnitY()).toRotationMatrix();
-  if (start.along_axis_3d) {
-    // Then tipped about the camera-frame axis perpendicular to both (the image-plane direction and
-    // the 3D axis) until the fingers run along the 3D axis: the palm (or back) stays as square to
-    // the camera as that allows.
-    const Vector3d in_plane = turn * Vector3d(0, -1, 0);
-    const Vector3d along = (Eigen::AngleAxisd(start.in_plane_offset_rad, Vector3d::UnitZ()) * axis).normalized();
-    turn = Eigen::Quaterniond::FromTwoVectors(in_plane, along).toRotationMatrix() * turn;
-  }
-  params.segment<3>(kRotationParam) = rotation_log(turn);
-  if (start.closed) {
-    for (int f = 0; f < kNumFingers; ++f) {
-      for (int d = 0; d < 4; ++d) {
-        params[angle_param(f, d)] = (f == kThumb ? kClosedThumb : kClosedFinger)[static_cast<size_t>(d)];
-      }
-    }
-  }
-  // The segmented palm centre is a surface point; the model's palm centre lies behind it: half a
-  // palm thickness behind the palm or the back, half the palm's width behind an edge. A closed hand
-  // with its palm toward the camera shows its curled fingers, which lie in front of the palm by
-  // about two finger thicknesses.
-  // (Measured the other way, as the depth of the posed model's nearest surface along the ray
-  // through its palm centre, this put the fists of fingercount 75 mm off.)
-  const double palm_half_thickness = model_.palm_half_thickness_mm();
-  const double palm_half_width = model_.palm_half_width_mm();
-  // cos(turn): 1 with the palm toward the camera, -1 with the back (the curled fingers behind it).
-  const double palm_toward = std::max(0.0, std::cos(start.turn_rad));
-  const double facing = std::abs(std::cos(start.turn_rad));
-  const double behind_surface = facing * palm_half_thickness + (1.0 - facing) * palm_half_width +
-                                (start.closed ? palm_toward * kClosedFingersInFrontMm : 0.0);
-  const Vector3d target = place.palm_centre_mm + Vector3d(0, 0, behind_surface);
-  // The model's palm centre turned as the pose turns it (no PosedHand: a check screens hypotheses
-  // on the hot path, where nothing is allocated).
-  const Vector3d centre = hand_rotation(params) * model_.palm_centre();
-  params.segment<3>(kTranslationParam) = target - centre;
-  return params;
-}
-
-double PoseTracker::confidence(const DepthInput& input, const PosedHand& hand) const {
-  return explain(input, hand).confidence;
-}
-
-PoseTracker::Explained PoseTracker::explain(const DepthInput& input, const PosedHand& hand) const {
-  if (input.gaussians.empty()) return {};
-  const auto& cam = input.camera;
-  const auto& gaussians = model_.gaussians();
-  struct Projected {
-    double u, v, sigma, depth, reach;
-  };
-  std::array<Projected, 64> projected{};
-  const int m = std::min<int>(hand.gaussian_count(), static_cast<int>(projected.size()));
-  int bad = 0;
-  for (int p = 0; p < m; ++p) {
-    const Vector3d& mu = hand.centre(p);
-    const double sigma_h = gaussians[static_cast<size_t>(p)].sigma_mm;
-    if (mu.z() < kMinProjectableDepthMm) {
-      ++bad;
-      projected[static_cast<size_t>(p)] = {-1e9, -1e9, 0, 0, 0};
-      continue;
-    }
-    const Eigen::Vector2d uv = cam.project(mu);
-    projected[static_cast<size_t>(p)] = {uv.x(), uv.y(), sigma_h * cam.focal() / mu.z(), mu.z() - sigma_h,
-                                         kExplainSigmas * sigma_h + kExplainMarginMm};
-    // A model Gaussian over no data or over background floats in empty space; one behind data
-    // nearer the camera is merely occluded.
-    const int u = static_cast<int>(std::lround(uv.x()));
-    const int v = static_cast<int>(std::lround(uv.y()));
-    if (u < 0 || v < 0 || u >= cam.width || v >= cam.height) {
-      ++bad;
-      continue;
-    }
-    const float d = input.filtered_mm[static_cast<size_t>(v) * cam.width + u];
-    const double surface = mu.z() - sigma_h;
-    if (d <= 0.0F || d > surface + kFloatSigmas * sigma_h + kFloatMarginMm) ++bad;
-  }
-  // Each leaf is explained by the covering model Gaussian nearest to it (relative to its reach in
-  // the image); a labelled leaf agrees when that Gaussian is of the same finger (or both palm).
-  double covered = 0.0;
-  double total = 0.0;
-  double labelled = 0.0;
-  double agreeing = 0.0;
-  for (const auto& q : input.gaussians) {
-    const double area = static_cast<double>(q.side_px) * q.side_px;
-    total += area;
-    int nearest = -1;
-    double nearest_ratio = 1.0;
-    for (int p = 0; p < m; ++p) {
-      const auto& pr = projected[static_cast<size_t>(p)];
-      const double du = pr.u - q.u;
-      const double dv = pr.v - q.v;
-      const double r = pr.sigma + 0.5 * q.side_px;
-      const double ratio = (du * du + dv * dv) / (r * r);
-      if (ratio < nearest_ratio && std::abs(pr.depth - q.depth_mm) < pr.reach) {
-        nearest = p;
-        nearest_ratio = ratio;
-        if (q.label == kBackground) break;  // any covering Gaussian explains an unlabelled leaf
-      }
-    }
-    if (nearest < 0) continue;
-    covered += area;
-    if (q.label != kBackground) {
-      labelled += area;
-      if (part_finger(q.label) == part_finger(gaussians[static_cast<size_t>(nearest)].label)) agreeing += area;
-    }
-  }
-  const double coverage = total > 0.0 ? covered / total : 0.0;
-  return {coverage * (1.0 - static_cast<double>(bad) / std::max(1, m)), labelled > 0.0 ? agreeing / labelled : -1.0};
-}
-
-TrackerOutput PoseTracker::optimise(const DepthInput& input, CheckPace pace) {
+TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   const auto no_hand = [&]() {
     reset();
     recovering_ = true;
@@ -579,15 +415,15 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input, CheckPace pace) {
     return none;
   };
   if (!input.has_hand()) return no_hand();
-  EnergyFrame frame{&model_, &input, nullptr, nullptr, other_hand_};
+  EnergyFrame frame{&model(), &input, nullptr, nullptr, other_hand_};
   OptimizerResult best{PoseParams::Zero(), -1e300};
   int winner = -1;
   bool guided_won = false;
-  const bool fuse = fuses(input);
+  const bool fuse = search_.fuses(input);
   bool started = false;
   CheckOutcome check = CheckOutcome::kNone;
   if (!previous_) {
-    best = restart(input).result;
+    best = search_.run(input).result;
     started = true;
     recovering_ = true;
   } else {
@@ -599,7 +435,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input, CheckPace pace) {
       PoseParams particle = *previous_;
       for (int j = 0; j < kNumPoseParams; ++j) particle[j] += alpha(rng_) * velocity[j];
       const bool guided = fuse && i == config_.particles - 1;
-      auto r = optimizer_.maximise(guided ? guided_energy_ : energy_, frame, particle, scratch_);
+      auto r = optimizer_.maximise(guided ? search_.guided_energy() : search_.depth_energy(), frame, particle, scratch_);
       iterations_ += config_.optimizer.iterations;
       // Late fusion (Sec. 5): "the pose particle which converges with the best energy value is
       // chosen". The particles optimise different energies, so each is judged by one common energy.
@@ -612,32 +448,38 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input, CheckPace pace) {
     }
   }
 
-  scratch_.update(model_, best.params);
-  Explained explained = explain(input, scratch_);
-  if (next_check_ != CheckCause::kNone && previous_) {
-    // The hypotheses are placed on this frame's hand, segmented afresh (hint()), not where the
-    // doubted pose says; the later frames of the check are segmented with the hint again (a fresh
-    // segmentation on each of them lost the hand in one of them: docs/TRACKER.md).
-    const HandPlace place{input.palm_centre_mm, input.finger_axis};
-    check_ = Check{true, next_check_, place, input.hand_centroid_mm, start_count(place), 0, 0};
-    screened_.clear();
-    next_check_ = CheckCause::kNone;
-  }
-  if (check_.active) {
-    // A suspected gross error: the tracked pose competes with the (re)start hypotheses, searched
-    // for over the next frames (continue_check); a (re)start replaces it only when it explains
-    // clearly more of the hand on the same frame (check_replace_margin), so a check cannot make
-    // good tracking worse by this measure.
-    const std::optional<Fit> fresh = continue_check(input, explained, pace);
-    check = fresh ? CheckOutcome::kRestartWon : check_.active ? CheckOutcome::kChecking : CheckOutcome::kTrackedKept;
-    if (fresh) {
-      best = fresh->result;
-      explained = fresh->explained;
-      winner = -1;
-      guided_won = false;
-      before_previous_.reset();  // no velocity from the wrong pose to the restart
-      previous_.reset();
+  scratch_.update(model(), best.params);
+  FitExplained explained = search_.explain(input, scratch_);
+  // A suspected gross error: the tracked pose competes with the (re)start hypotheses, searched for
+  // on this thread over the next frames (continue_check) or on the background thread
+  // (background_check); a (re)start replaces it only when it explains clearly more of the hand on
+  // the same frame (check_replace_margin), so a check cannot make good tracking worse by this
+  // measure.
+  std::optional<StartFit> fresh;
+  if (background_ && previous_) {
+    check = background_check(input, explained, fresh);
+  } else {
+    if (next_check_ != CheckCause::kNone && previous_) {
+      // The hypotheses are placed on this frame's hand, segmented afresh (hint()), not where the
+      // doubted pose says; the later frames of the check are segmented with the hint again (a
+      // fresh segmentation on each of them lost the hand in one of them: docs/TRACKER.md).
+      const HandPlace place{input.palm_centre_mm, input.finger_axis};
+      check_ = Check{true, next_check_, place, input.hand_centroid_mm, StartSearch::hypothesis_count(place), 0, 0, {}};
+      search_.clear();
+      next_check_ = CheckCause::kNone;
     }
+    if (check_.active) {
+      fresh = continue_check(input, explained);
+      check = fresh ? CheckOutcome::kRestartWon : check_.active ? CheckOutcome::kChecking : CheckOutcome::kTrackedKept;
+    }
+  }
+  if (fresh) {
+    best = fresh->result;
+    explained = fresh->explained;
+    winner = -1;
+    guided_won = false;
+    before_previous_.reset();  // no velocity from the wrong pose to the restart
+    previous_.reset();
   }
   const double conf = explained.confidence;
   watch_confidence(conf, check);
@@ -670,104 +512,64 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input, CheckPace pace) {
   return out;
 }
 
-PoseTracker::Fit PoseTracker::fit_from(const DepthInput& input, const PoseParams& from, int iterations,
-                                        const PoseEnergy& with) {
-  const EnergyFrame frame{&model_, &input, nullptr, nullptr, other_hand_};
-  const auto r = optimizer_.maximise(with, frame, from, scratch_, iterations);
-  iterations_ += iterations;
-  scratch_.update(model_, r.params);
-  return Fit{r, explain(input, scratch_)};
-}
-
-const PoseEnergy& PoseTracker::start_energy(const DepthInput& input) const {
-  return fuses(input) ? guided_energy_ : energy_;
-}
-
-PoseTracker::Fit PoseTracker::screen(const DepthInput& input, const HandPlace& place, size_t k) {
-  return fit_from(input, initial_pose(place, start_at(k)), std::min(kScreenIterations, config_.init_iterations),
-                  start_energy(input));
-}
-
-void PoseTracker::keep_best_screened(const DepthInput& input) {
-  // The kRefinedStarts best by fit score go on, each with the start energy and, with late fusion,
-  // also with the depth-only energy: on real depth the forest (trained on renders) mislabels, and
-  // the guided energy alone fitted 3 of 7 SR305 frames as the other hand (docs/TRACKER.md, "Real
-  // frames").
-  const auto kept = std::min(kRefinedStarts, screened_.size());
-  std::partial_sort(screened_.begin(), screened_.begin() + static_cast<std::ptrdiff_t>(kept), screened_.end(),
-                    better);
-  screened_.resize(kept);
-  if (&start_energy(input) != &energy_) {
-    for (size_t k = 0; k < kept; ++k) screened_.push_back(screened_[k]);
-  }
-}
-
-PoseTracker::Fit PoseTracker::refine(const DepthInput& input, int iterations) {
-  // screened_ after keep_best_screened(): the start energy's candidates first, then (late fusion)
-  // the depth-only ones.
-  Fit best;
-  for (size_t k = 0; k < screened_.size(); ++k) {
-    const PoseEnergy& with = k < kRefinedStarts ? start_energy(input) : energy_;
-    screened_[k] = iterations > 0 ? fit_from(input, screened_[k].result.params, iterations, with) : screened_[k];
-    if (better(screened_[k], best)) best = screened_[k];
-  }
-  return best;
-}
-
-bool PoseTracker::better(const Fit& a, const Fit& b) {
-  // By score; on a tie (the same share explained), by energy.
-  return a.explained.score() > b.explained.score() + 1e-9 ||
-         (a.explained.score() > b.explained.score() - 1e-9 && a.result.energy > b.result.energy);
-}
-
-PoseTracker::Fit PoseTracker::restart(const DepthInput& input) {
-  // The hypotheses are compared by confidence, not energy: E_sim has no notion of occlusion, so
-  // a wrong pose that pushes the big palm Gaussians onto the visible surface can out-score the right
-  // one (seen on fists), while it explains little of the hand's outline. No temporal prior: the
-  // history is what is in doubt. With late fusion the hypotheses optimise the detection-guided
-  // energy (Sec. 4.3): the part labels say where the palm and each finger are, which the open and
-  // closed hands do not know (docs/TRACKER.md "Recovery": 17 of 21 knocked-off trackers back
-  // within 30 frames with the depth-only energy, 21 with this one).
-  //
-  // Successive halving: every hypothesis gets kScreenIterations, then only the kRefinedStarts best
-  // (by fit score) get the rest of init_iterations. All hypotheses to the end cost 24-48 x 80
-  // iterations, 40-100 ms on one frame at every start (and check made at once).
-  screened_.clear();
-  const HandPlace place{input.palm_centre_mm, input.finger_axis};
-  for (size_t k = 0; k < start_count(place); ++k) screened_.push_back(screen(input, place, k));
-  keep_best_screened(input);
-  return refine(input, config_.init_iterations - kScreenIterations);
-}
-
-std::optional<PoseTracker::Fit> PoseTracker::continue_check(const DepthInput& input, const Explained& tracked,
-                                                            CheckPace pace) {
-  // restart()'s search, about check_iterations_per_frame iterations a frame: hypotheses screened on each
-  // frame (placed where the check's first frame found the hand), then the best refined together, each
-  // frame continuing from the last (the hand moves meanwhile), and the best of them compared with
-  // the tracked pose on the last frame.
+std::optional<StartFit> PoseTracker::continue_check(const DepthInput& input, const FitExplained& tracked) {
+  // StartSearch::run()'s search, about check_iterations_per_frame iterations a frame: hypotheses
+  // screened on each frame (placed where the check's first frame found the hand), then the best
+  // refined together, each frame continuing from the last (the hand moves meanwhile), and the best
+  // of them compared with the tracked pose on the last frame.
   const int per_frame_iterations = config_.check_iterations_per_frame;
-  const bool at_once = pace == CheckPace::kAtOnce || per_frame_iterations <= 0;
+  const bool at_once = per_frame_iterations <= 0;
   if (check_.screened < check_.starts) {
-    const auto per_frame = static_cast<size_t>(std::max(1, per_frame_iterations / kScreenIterations));
+    const auto per_frame = static_cast<size_t>(std::max(1, per_frame_iterations / StartSearch::kScreenIterations));
     const size_t end = at_once ? check_.starts : std::min(check_.starts, check_.screened + per_frame);
     // Placed where the check's first frame found the hand, moved as the segmented hand's centroid
     // has moved since.
     HandPlace place = check_.place;
     place.palm_centre_mm += input.hand_centroid_mm - check_.centroid_mm;
-    for (; check_.screened < end; ++check_.screened) screened_.push_back(screen(input, place, check_.screened));
-    if (check_.screened == check_.starts) keep_best_screened(input);
+    for (; check_.screened < end; ++check_.screened) search_.screen(input, place, check_.screened);
+    if (check_.screened == check_.starts) search_.keep_best(input);
     if (!at_once) return std::nullopt;
   }
-  const int rest = std::max(0, config_.init_iterations - kScreenIterations) - check_.refined;
-  const int slice = std::max(1, per_frame_iterations / static_cast<int>(screened_.size()));
+  const int rest = search_.refine_iterations() - check_.refined;
+  const int slice = std::max(1, per_frame_iterations / static_cast<int>(search_.kept()));
   const bool last = at_once || slice >= rest;
   const int iterations = last ? rest : slice;
   check_.refined += iterations;
-  const Fit best = refine(input, iterations);
+  const StartFit best = search_.refine(input, iterations);
   if (!last) return std::nullopt;
   check_.active = false;
-  return best.explained.score() > tracked.score() + config_.check_replace_margin ? std::optional<Fit>(best)
+  return best.explained.score() > tracked.score() + config_.check_replace_margin ? std::optional<StartFit>(best)
                                                                                  : std::nullopt;
+}
+
+PoseTracker::CheckOutcome PoseTracker::background_check(const DepthInput& input, const FitExplained& tracked,
+                                                        std::optional<StartFit>& fresh) {
+  if (next_check_ != CheckCause::kNone) {
+    // The search runs on copies of this frame's input (segmented afresh: hint()) and of the other
+    // hand as it is now; while the last search's result is still under way (a cancelled one
+    // finishing) the check waits for the next frame.
+    if (!background_->submit(input, other_hand_, config_.scale)) return CheckOutcome::kNone;
+    check_ = Check{true, next_check_, {}, input.hand_centroid_mm, 0, 0, 0, tracked};
+    next_check_ = CheckCause::kNone;
+    return CheckOutcome::kChecking;
+  }
+  if (!check_.active) return CheckOutcome::kNone;
+  const std::optional<StartFit> found = background_->take();
+  if (!found) return CheckOutcome::kChecking;
+  check_.active = false;
+  // Compared with the tracked pose on the check's frame, as a check on this thread compares them.
+  if (found->explained.score() <= check_.tracked.score() + config_.check_replace_margin) {
+    return CheckOutcome::kTrackedKept;
+  }
+  // The (re)start is of a frame some frames ago: moved as the segmented hand has moved since, and
+  // fitted to this frame with the tracking's iterations. It replaces the tracked pose where it
+  // explains this frame better too (the tracked pose may have found the hand meanwhile).
+  PoseParams moved = found->result.params;
+  moved.segment<3>(kTranslationParam) += input.hand_centroid_mm - check_.centroid_mm;
+  const StartFit now = search_.fit(input, moved, config_.optimizer.iterations);
+  if (now.explained.score() <= tracked.score()) return CheckOutcome::kTrackedKept;
+  fresh = now;
+  return CheckOutcome::kRestartWon;
 }
 
 void PoseTracker::watch_confidence(double conf, CheckOutcome check) {
@@ -799,27 +601,20 @@ void PoseTracker::watch_confidence(double conf, CheckOutcome check) {
                           : CheckCause::kNone;
 }
 
-bool PoseTracker::fuses(const DepthInput& input) const {
-  // Late fusion needs part labels on the leaves; without them every particle is depth-only.
-  return config_.mode == EnergyMode::kLateFusion &&
-         std::any_of(input.gaussians.begin(), input.gaussians.end(),
-                     [](const ImageGaussian& g) { return g.label != kBackground; });
-}
-
 TrackerOutput PoseTracker::describe(const PoseParams& params, double energy,
                                     TrackingState state) {
   TrackerOutput out;
   out.state = state;
   out.params = params;
   out.energy = energy;
-  scratch_.update(model_, params);
+  scratch_.update(model(), params);
   out.joints = scratch_.joints();
   for (int f = 0; f < kNumFingers; ++f) out.fingertips[static_cast<size_t>(f)] = scratch_.fingertip(f);
-  out.palm_centre = scratch_.to_camera(model_.palm_centre());
+  out.palm_centre = scratch_.to_camera(model().palm_centre());
   out.palm_normal = scratch_.camera_R_hand() * Vector3d::UnitZ();
   // Tip Gaussians are the last of each finger's list: surface distance = centre distance - radii.
   const auto tip_sigma = [&](int finger) {
-    return model_.gaussians()[static_cast<size_t>(kBonesPerFinger * 2 * finger + 5)].sigma_mm;
+    return model().gaussians()[static_cast<size_t>(kBonesPerFinger * 2 * finger + 5)].sigma_mm;
   };
   out.pinch_distance_mm = std::max(0.0, (out.fingertips[kThumb] - out.fingertips[kIndex]).norm() -
                                             tip_sigma(kThumb) - tip_sigma(kIndex));

@@ -127,7 +127,7 @@ const std::vector<Field>& fields() {
     {"tracker.handedness_recheck_frames",
      IntRef{[](DaemonConfig& c) -> int& { return c.tracker.handedness_recheck_frames; }}, 0, 100000,
      "auto: a hand whose fit stays below recheck_below_confidence is tried as the other hand again every this many "
-     "frames (0: never; never with check_iterations_per_frame > 0)",
+     "frames (0: never; never with check_iterations_per_frame > 0 or background_checks)",
      true},
     {"tracker.max_hands", IntRef{[](DaemonConfig& c) -> int& { return c.tracker.max_hands; }}, 1, kMaxHands,
      "hands tracked at once (each its own id, handedness and pose; optimized on two cores)", true},
@@ -161,6 +161,10 @@ const std::vector<Field>& fields() {
      IntRef{[](DaemonConfig& c) -> int& { return c.tracker.check_iterations_per_frame; }}, 0, 1000,
      "0: a check is made on one frame (10-16 ms); N: spread over frames, about N iterations each (64: every frame "
      "within about 3 ms, a gross error repaired in about 14 frames instead of 2)",
+     true},
+    {"tracker.background_checks", BoolRef{[](DaemonConfig& c) -> bool& { return c.tracker.background_checks; }}, 0, 0,
+     "true: a check's whole search runs on a thread of its own on idle CPU time only, and no frame waits for it "
+     "(check_iterations_per_frame unused; a gross error repaired once the idle CPU has done the search)",
      true},
     {"tracker.fusion_label_weight", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.fusion_label_weight; }},
      0, 1, "late fusion: share of the label similarity in the energy that picks the winning particle", true},

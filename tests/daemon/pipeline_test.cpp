@@ -2,7 +2,8 @@
 // tracking resumes at the new resolution), frames with no depth in the working volume (no_hand,
 // counted), and the newest-frame-wins policy of a live source whose frames come faster than the
 // optimizer can take them (drops counted, poses stay fresh, every frame accounted for); two hands
-// per frame, the second optimized on the side thread (also under ThreadSanitizer: tsan/run.sh).
+// per frame, the second optimized on the side thread, and checks searched on threads of their own
+// (also under ThreadSanitizer: tsan/run.sh).
 #include "handtrack/daemon/pipeline.hpp"
 #include "source_frames.hpp"
 #include "handtrack/ipc/pose_ring_reader.hpp"
@@ -242,6 +243,33 @@ TEST(Pipeline, LiveSourceFasterThanTheOptimizerDropsOldestFramesAndStaysFresh) {
   std::printf("live overload: %zu published, %llu dropped, age p50 %.1f ms, max %.1f ms, work p50 %.1f ms\n",
               records.size(), static_cast<unsigned long long>(c.frames_dropped), p50, age_ms.back(), work);
   EXPECT_LT(p50, 3.0 * work + 10.0);
+}
+
+// Background checks (tracker.background_checks): the searches run on their own threads beside the
+// pipeline's, on copies of the frames they check (also under ThreadSanitizer). A camera at 30 fps
+// leaves idle CPU for them; every tracked hand is rechecked every 5 frames here, so that searches
+// are under way while frames are tracked and published, and while the pipeline stops.
+TEST(Pipeline, BackgroundChecksSearchBesideThePipeline) {
+  constexpr uint64_t kFrames = 60;
+  auto camera = std::make_shared<synth::SyntheticCamera>(synthetic_source_options("pinch"));
+  auto source = std::make_unique<ScriptedSource>(kFrames, true, [camera](uint64_t i, RawFrame& f) {
+    std::this_thread::sleep_for(33ms);
+    to_raw(camera->render(static_cast<int>(i)).depth, f);
+  });
+  DaemonConfig config;
+  config.max_frames = kFrames;
+  config.tracker.background_checks = true;
+  config.tracker.recheck_interval_frames = 5;
+  config.tracker.recheck_below_confidence = 1.0;
+  const uint64_t searched_before = background_searches_finished();
+  const auto [records, c] = run_to_end(config, std::move(source));
+  EXPECT_EQ(c.frames_published + c.frames_dropped + c.frames_skipped, c.frames_captured);
+  const auto with_hand =
+      std::count_if(records.begin(), records.end(), [](const ipc::FrameRecord& r) { return r.hand_count == 1; });
+  EXPECT_GE(with_hand, static_cast<std::ptrdiff_t>(records.size()) / 2) << "of " << records.size() << " frames";
+  std::printf("%llu background searches finished during %zu published frames\n",
+              static_cast<unsigned long long>(background_searches_finished() - searched_before), records.size());
+  EXPECT_GT(background_searches_finished(), searched_before) << "no background search finished";
 }
 
 }  // namespace

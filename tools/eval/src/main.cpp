@@ -232,6 +232,10 @@ int main(int argc, char** argv) {
                  "try a hand whose fit stays below recheck_below_confidence as the other hand again every N frames "
                  "(default 60; 0: never; docs/TRACKER.md, \"Handedness by evidence over frames\")")
       ->check(CLI::Range(0, 100000));
+  app.add_flag("--background-checks", config.background_checks,
+               "checks searched on a thread of their own, as handtrackd does: frames never wait for a search, a "
+               "check's result is taken when the other core has done it (the scores then vary from run to run; "
+               "docs/TRACKER.md, \"Checks in the background\")");
   bool sim_only = false;
   app.add_flag("--sim-only", sim_only, "E_sim only: drop E_col, E_lim and E_smo (ablation of Fig. 6)");
   int max_hands = kMaxHands;

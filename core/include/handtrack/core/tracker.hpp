@@ -13,8 +13,10 @@
 #include "handtrack/core/hand_model.hpp"
 #include "handtrack/core/optimizer.hpp"
 #include "handtrack/core/sequence.hpp"
+#include "handtrack/core/start_search.hpp"
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <random>
 #include <string>
@@ -101,6 +103,16 @@ struct TrackerConfig {
   // within about 3 ms, but repair a gross error in about 14 frames instead of 2 and cost the
   // broadened benchmark 0.5 mm (docs/TRACKER.md, "Checks spread over frames").
   int check_iterations_per_frame = 0;
+  // true: a check's whole (re)start search runs on a thread of its own at the lowest scheduling
+  // priority (SCHED_IDLE: only CPU time no other thread wants) on a copy of the check's first frame,
+  // and its result is taken at the first frame after it finishes (check_iterations_per_frame is
+  // then unused). No tracked frame waits for a search; a gross error is repaired when the idle CPU
+  // has done the search (a few frames at a camera's rate), and on a machine with no idle CPU only
+  // by the lost rule. As with checks spread over frames, a hand chosen by a trial is not put to a
+  // trial again and a hand lost during a trial is not (re)started again (Tracker). handtrackd's
+  // default; the library's is false, which keeps every run of handtrack-eval the same
+  // (docs/TRACKER.md, "Checks in the background").
+  bool background_checks = false;
   // A (re)start must explain at least this much of the segmented surface, or there is no hand.
   double min_start_confidence = 0.6;
   // Auto handedness (Tracker; ours): the hand is chosen by evidence over frames, not on one frame.
@@ -141,6 +153,8 @@ struct TrackerConfig {
 // an energy reads it (late fusion with w_f > 0: PoseTracker). Every TrackerInputs and HandsInputs
 // made for a tracker is made with this.
 DepthInputConfig input_config(const TrackerConfig& config);
+// The weights of `config`'s energies: E_free (w_f) only with late fusion.
+EnergyWeights mode_weights(const TrackerConfig& config);
 
 // N points at the origin (Eigen leaves a default-constructed vector uninitialised).
 template <size_t N>
@@ -159,7 +173,7 @@ struct TrackerOutput {
   Eigen::Vector3d palm_normal = Eigen::Vector3d::Zero();  // out of the palm, camera frame
   double energy = 0.0;
   double confidence = 0.0;           // fraction of the hand's depth explained by the model, in [0, 1]
-  // With part labels: how far they agree with the fitted model (PoseTracker::Explained), else -1.
+  // With part labels: how far they agree with the fitted model (FitExplained), else -1.
   double label_agreement = -1.0;
   double pinch_distance_mm = 0.0;    // thumb tip to index tip, surface to surface
   double pinch_strength = 0.0;       // 1 = touching, 0 = apart (>= 40 mm)
@@ -182,23 +196,22 @@ struct TrackerOutput {
   [[nodiscard]] double score() const;
 };
 
-// How well a fit explains the segmented hand, for choosing between fits (the (re)start hypotheses,
-// the tracked pose against a (re)start, one hand against the other): the confidence, times the
-// label agreement where there are part labels. Without the labels a hand fitted with its thumb on
-// its little finger's side explains the depth about as well as the right one (a right hand's back
-// fitted as a left hand's back: docs/TRACKER.md, "Every view").
-double fit_score(double confidence, double label_agreement);
+class BackgroundSearch;
 
 class PoseTracker {
  public:
   explicit PoseTracker(TrackerConfig config = {});
+  ~PoseTracker();
+  PoseTracker(PoseTracker&&) noexcept;
+  PoseTracker& operator=(PoseTracker&&) noexcept;
 
   // Where segmentation should look for the hand in the next frame: none before the first pose,
   // after the fit was lost, and before a check against a (re)start (the next frame is segmented
   // afresh). Allocates nothing.
   [[nodiscard]] std::optional<HandHint> hint() const;
-  // Optimiser iterations since the last call (TrackerOutput::iterations).
-  int take_iterations() { return std::exchange(iterations_, 0); }
+  // Optimiser iterations since the last call (TrackerOutput::iterations); a background search's
+  // are its thread's, not counted.
+  int take_iterations() { return std::exchange(iterations_, 0) + search_.take_iterations(); }
   // No tracked pose: the next frame (re)starts.
   [[nodiscard]] bool lost() const { return !previous_; }
   // The running confidence of the tracked pose is below TrackerConfig::recheck_below_confidence.
@@ -206,89 +219,52 @@ class PoseTracker {
     return previous_ && confidence_level_ < config_.recheck_below_confidence;
   }
   // Optimises the pose for one frame's C_I and updates the history.
-  // How a check of a suspect fit is made: its search spread over the next frames (the fit stays
-  // the tracked one meanwhile; TrackerConfig::check_iterations_per_frame > 0), or all on this frame.
-  enum class CheckPace { kSpread, kAtOnce };
-  TrackerOutput optimise(const DepthInput& input, CheckPace pace = CheckPace::kSpread);
+  TrackerOutput optimise(const DepthInput& input);
   // Forget the history: the next frame starts from the open hand.
   void reset();
   // Replaces the tracker's belief about the last pose (both previous poses) by `pose`: how tests
   // knock the tracker off to check that it recovers.
   void override_pose(const PoseParams& pose);
+  // With background checks: blocks until the check under way (if any) has finished, so that the
+  // next optimise() takes its result, as if the camera had waited for it (tests).
+  void wait_for_check();
 
-  [[nodiscard]] const HandModel& model() const { return model_; }
+  [[nodiscard]] const HandModel& model() const { return search_.model(); }
   [[nodiscard]] const TrackerConfig& config() const { return config_; }
   void set_scale(const HandScale& scale);
   // Another hand in the frame, in this tracker's camera frame, that the fit must not enter
   // (E_hand); null: none. It must outlive the optimise() calls that use it.
-  void set_other_hand(const HandObstacle* other) { other_hand_ = other; }
-  // One (re)start hypothesis: Sec. 5's open hand, or a closed one, placed at the segmented hand.
-  struct Start {
-    double in_plane_offset_rad = 0.0;  // turned about the camera axis away from the segmented axis
-    bool closed = false;               // a fist instead of the open hand
-    // Turned about the hand's finger axis: 0 the palm toward the camera, pi the back, +-pi/2 a side
-    // (the thumb's or the little finger's edge) toward it.
-    double turn_rad = 0.0;
-    bool along_axis_3d = false;        // fingers along the segmented axis in 3D, not in the image plane
-  };
-  // Where a (re)start places its hypotheses: the segmented hand's palm centre and finger axis.
-  struct HandPlace {
-    Eigen::Vector3d palm_centre_mm = Eigen::Vector3d::Zero();
-    Eigen::Vector3d finger_axis = Eigen::Vector3d(0, -1, 0);
-  };
-  [[nodiscard]] PoseParams initial_pose(const HandPlace& place, const Start& start) const;
-  // How much of the segmented hand the posed model explains, in [0, 1].
-  [[nodiscard]] double confidence(const DepthInput& input, const PosedHand& hand) const;
-  struct Explained {
-    double confidence = 0.0;
-    // Of the labelled hand pixels the model explains, the share whose part label (Sec. 4.3) names
-    // the finger (or the palm) of the model Gaussian that explains them; -1 without labels.
-    double label_agreement = -1.0;
-    [[nodiscard]] double score() const { return fit_score(confidence, label_agreement); }
-  };
-  [[nodiscard]] Explained explain(const DepthInput& input, const PosedHand& hand) const;
+  void set_other_hand(const HandObstacle* other) {
+    other_hand_ = other;
+    search_.set_other_hand(other);
+  }
 
  private:
   TrackerOutput describe(const PoseParams& params, double energy, TrackingState state);
-  // A pose and how much of the segmented hand it explains.
-  struct Fit {
-    OptimizerResult result{PoseParams::Zero(), -1e300};
-    Explained explained{-1.0, -1.0};
-  };
-  // Sec. 5's start: the (re)start hypotheses optimised on `input`, the best by fit score.
-  Fit restart(const DepthInput& input);
-  // The pieces of restart() (successive halving): the hypotheses in order, how many a frame gets
-  // (24, or 48 for a hand out of the image plane), the k-th screened, the best kept, and their
-  // refinement.
-  static Start start_at(size_t k);
-  static size_t start_count(const HandPlace& place);
-  Fit fit_from(const DepthInput& input, const PoseParams& from, int iterations, const PoseEnergy& with);
-  [[nodiscard]] const PoseEnergy& start_energy(const DepthInput& input) const;
-  Fit screen(const DepthInput& input, const HandPlace& place, size_t k);
-  void keep_best_screened(const DepthInput& input);
-  // Every kept hypothesis `iterations` further on `input`; the best.
-  Fit refine(const DepthInput& input, int iterations);
-  static bool better(const Fit& a, const Fit& b);
-  // A suspect-fit check, one slice of the (re)start search per frame: the fit that replaces the
-  // tracked pose (`tracked`: how well it explains this frame), or nullopt.
-  std::optional<Fit> continue_check(const DepthInput& input, const Explained& tracked, CheckPace pace);
+  // Why a check is made: the confidence fell (suspect), or a mediocre fit is looked at again.
+  enum class CheckCause { kNone, kFall, kRecheck };
+  // What a frame did about a check: none under way, one under way, one ended with the tracked
+  // pose kept or replaced.
+  enum class CheckOutcome { kNone, kChecking, kTrackedKept, kRestartWon };
+  // A suspect-fit check on this frame's thread, one slice of the (re)start search per frame (all
+  // of it on one frame when check_iterations_per_frame is 0): the fit that replaces the tracked
+  // pose (`tracked`: how well it explains this frame), or nullopt.
+  std::optional<StartFit> continue_check(const DepthInput& input, const FitExplained& tracked);
+  // A check on the background thread (TrackerConfig::background_checks): started on this frame's
+  // input (next_check_), or taken when it has finished; a (re)start that won becomes the history,
+  // moved as the segmented hand has moved since its frame.
+  CheckOutcome background_check(const DepthInput& input, const FitExplained& tracked, std::optional<StartFit>& fresh);
   // After a frame's fit: tracks the running confidence level and decides whether the next frame
   // checks the tracked pose against a (re)start.
-  enum class CheckOutcome { kNone, kChecking, kTrackedKept, kRestartWon };
   void watch_confidence(double confidence, CheckOutcome check);
-  // Late fusion with part labels on the leaves.
-  [[nodiscard]] bool fuses(const DepthInput& input) const;
 
   TrackerConfig config_;
-  HandModel model_;
+  StartSearch search_;  // the (re)starts, the checks on this thread, and explain()
   // Late fusion: the particles' common energy at `params` (see EnergyMode).
-
-  PoseEnergy energy_;            // depth-only (Sec. 4.1)
-  PoseEnergy guided_energy_;     // detection-guided (Sec. 4.3), augmented: depth and label factors
   PoseEnergy common_energy_;     // late fusion: compares the particles (label share fusion_label_weight)
   AdaptiveGradientAscent optimizer_;
   PosedHand scratch_;
-  std::vector<Fit> screened_;  // restart()'s hypotheses after their first iterations
+  std::unique_ptr<BackgroundSearch> background_;  // TrackerConfig::background_checks
   const HandObstacle* other_hand_ = nullptr;
   std::mt19937_64 rng_;
   std::optional<PoseParams> previous_;
@@ -296,21 +272,24 @@ class PoseTracker {
   int low_confidence_run_ = 0;
   bool recovering_ = false;
   double confidence_level_ = 0.0;     // running level of the tracked pose's confidence
-  // Why a check is made: the confidence fell (suspect), or a mediocre fit is looked at again.
-  enum class CheckCause { kNone, kFall, kRecheck };
-  CheckCause next_check_ = CheckCause::kNone;  // the next frame starts a check (continue_check)
+  CheckCause next_check_ = CheckCause::kNone;  // the next frame starts a check
   struct Check {
     bool active = false;
     CheckCause cause = CheckCause::kNone;
     HandPlace place;      // of the check's first frame
     Eigen::Vector3d centroid_mm = Eigen::Vector3d::Zero();  // of its segmented hand
     size_t starts = 0;    // hypotheses to screen
-    size_t screened = 0;  // of them so far (screened_)
+    size_t screened = 0;  // of them so far
     int refined = 0;      // refinement iterations done (of each kept hypothesis)
+    FitExplained tracked;  // background checks: the tracked pose on the check's first frame
   } check_;
   int frames_since_check_ = 0;
   int iterations_ = 0;  // take_iterations()
 };
+
+// Background checks' searches that have finished (TrackerConfig::background_checks), in this
+// process, dropped ones included: a statistic, and how tests see that the search thread ran.
+uint64_t background_searches_finished();
 
 // What the next frame's preprocessing should build for a Tracker: the inputs of the hands it will
 // fit, each with its segmentation hint (the mirrored frame's hint for the left hand).
@@ -413,8 +392,7 @@ class Tracker {
   // One frame of a handedness trial: the evidence from both hands' fits, the hand it favours
   // (current_), and the trial's end.
   void weigh(const TrackerOutput& as_right, const TrackerOutput& as_left);
-  TrackerOutput fit(Handedness hand, const DepthInput& input,
-                    PoseTracker::CheckPace pace = PoseTracker::CheckPace::kSpread);
+  TrackerOutput fit(Handedness hand, const DepthInput& input);
   void identify(TrackerOutput& out);  // sets out.hand_id
 
   PoseTracker right_;
