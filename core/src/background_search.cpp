@@ -28,7 +28,8 @@ void become_idle_class() {
 
 uint64_t background_searches_finished() { return finished_searches.load(std::memory_order_relaxed); }
 
-BackgroundSearch::BackgroundSearch(const TrackerConfig& config) : search_(config), scale_(config.scale) {}
+BackgroundSearch::BackgroundSearch(const TrackerConfig& config)
+    : search_(config), scale_(config.scale), thread_([this] { run(); }) {}
 
 BackgroundSearch::~BackgroundSearch() {
   {
@@ -36,14 +37,12 @@ BackgroundSearch::~BackgroundSearch() {
     stop_.store(true, std::memory_order_relaxed);
   }
   changed_.notify_all();
-  if (thread_.joinable()) {
-    // Back to the normal class, so that a search starved of idle time still reaches its next
-    // hypothesis soon and stops.
-    sched_param param{};
-    param.sched_priority = 0;
-    pthread_setschedparam(thread_.native_handle(), SCHED_OTHER, &param);
-    thread_.join();
-  }
+  // Back to the normal class, so that a search starved of idle time still reaches its next
+  // hypothesis soon and stops.
+  sched_param param{};
+  param.sched_priority = 0;
+  pthread_setschedparam(thread_.native_handle(), SCHED_OTHER, &param);
+  thread_.join();
 }
 
 bool BackgroundSearch::submit(const DepthInput& input, const HandObstacle* other, const HandScale& scale) {
@@ -56,7 +55,6 @@ bool BackgroundSearch::submit(const DepthInput& input, const HandObstacle* other
     scale_ = scale;
     state_ = State::kQueued;
   }
-  if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
   changed_.notify_all();
   return true;
 }

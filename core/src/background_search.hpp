@@ -6,7 +6,8 @@
 //
 // The thread runs under SCHED_IDLE on every CPU: it gets only time that no other thread of the
 // machine wants, so a pipeline thread that wakes preempts it at once, and a search takes as long
-// as the idle CPU allows. It starts at the first submit().
+// as the idle CPU allows. It starts with the object, so that a tracker's threads are the same from
+// its first frame to its last (a daemon's thread count says nothing leaked).
 //
 // Thread roles: submit(), busy(), take(), cancel() and wait() from the tracking thread (one at a
 // time); the search itself on the search thread.
@@ -56,7 +57,7 @@ class BackgroundSearch {
   bool has_other_ = false;
   HandScale scale_;
   StartFit result_;  // kDone
-  std::thread thread_;
+  std::thread thread_;  // last: started once everything it reads is constructed
 };
 
 }  // namespace handtrack

@@ -45,10 +45,13 @@ struct PipelineConfig {
   int stats_interval_ms = 1000;  // statistics into the ring header, STATUS= and the debug summary
 };
 
-// The tracker's defaults, with late fusion (the shipped forest): the daemon's best configuration.
-inline TrackerConfig late_fusion_defaults() {
+// The tracker's defaults, with late fusion (the shipped forest), and checks searched in the
+// background: a service's frames never wait for a search (docs/TRACKER.md, "Checks in the
+// background"), where handtrack-eval's runs must be the same every time.
+inline TrackerConfig daemon_tracker_defaults() {
   TrackerConfig c;
   c.mode = EnergyMode::kLateFusion;
+  c.background_checks = true;
   return c;
 }
 
@@ -68,7 +71,7 @@ struct DaemonConfig {
   // [pipeline]
   PipelineConfig pipeline;
   // [tracker], [tracker.input], [tracker.energy], [tracker.optimizer], [tracker.scale]
-  TrackerConfig tracker = late_fusion_defaults();
+  TrackerConfig tracker = daemon_tracker_defaults();
   // Part-classification forest (handtrack-train-forest) for late fusion (tracker.energy, Sec. 5);
   // empty: the shipped one (shipped_forest_path()).
   std::string forest_model;
