@@ -11,7 +11,9 @@
 #include <array>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <random>
+#include <string>
 #include <string_view>
 
 namespace handtrack {
@@ -149,6 +151,28 @@ TEST(TrackingRecovery, AMediocreFitIsRecheckedThoughItsConfidenceNeverFell) {
   EXPECT_LT(back_without, knocks) << "every knock is back without rechecks: the scenario no longer needs them";
 }
 
+// The one-hand motions of the latency settings' tests (checks spread over frames, in the
+// background), each knocked off as above after kKnockFrames with one random stream.
+constexpr std::array<std::string_view, 3> kLatencyMotions = {"random", "flexex1", "fingercount"};
+
+// Tracks kLatencyMotions with `config`; `watch` sees each frame's output, and whether the frame
+// before was tracked. Returns the knocks back within kRecoveryFrames.
+int latency_knocks_back(
+    const TrackerConfig& config, const PartForest& forest,
+    const std::function<void(std::string_view motion, int frame, const TrackerOutput& out, bool after_tracked)>& watch) {
+  int knocks_back = 0;
+  std::mt19937_64 rng(5);
+  for (const auto motion : kLatencyMotions) {
+    TrackingState last_state = TrackingState::kNoHand;
+    const auto recovered = knock_off_and_track(motion, config, forest, rng, [&](int i, const TrackerOutput& out) {
+      watch(motion, i, out, last_state == TrackingState::kTracking);
+      last_state = out.state;
+    });
+    knocks_back += static_cast<int>(std::count_if(recovered.begin(), recovered.end(), [](int f) { return f >= 1; }));
+  }
+  return knocks_back;
+}
+
 // Checks spread over frames (TrackerConfig::check_iterations_per_frame, the latency setting): a
 // frame that follows a tracked frame runs tracking's particles and at most about
 // check_iterations_per_frame more, never a whole (re)start search; only a frame with no pose to go
@@ -166,25 +190,19 @@ TEST(TrackingRecovery, ChecksSpreadOverFramesKeepEveryFrameShortAndStillRepairAG
   const int tracking_iterations = config.particles * config.optimizer.iterations;
   const int most_after_tracked = tracking_iterations + config.check_iterations_per_frame;
   constexpr int kMostKnocksBack = 7;  // of 3 motions x 3 knocks
-  int knocks_back = 0;
-  std::mt19937_64 rng(5);
-  for (const auto motion : {"random", "flexex1", "fingercount"}) {
-    TrackingState last_state = TrackingState::kNoHand;
-    int checking_frames = 0;
-    const auto watch = [&](int i, const TrackerOutput& out) {
-      if (i == 0) {
-        EXPECT_GT(out.iterations, most_after_tracked) << motion << ": the start searches at once";
-      }
-      if (last_state == TrackingState::kTracking) {
-        EXPECT_LE(out.iterations, most_after_tracked) << motion << " frame " << i << " stalls on a whole search";
-        checking_frames += out.iterations > tracking_iterations ? 1 : 0;
-      }
-      last_state = out.state;
-    };
-    const auto recovered = knock_off_and_track(motion, config, forest, rng, watch);
-    knocks_back += static_cast<int>(std::count_if(recovered.begin(), recovered.end(), [](int f) { return f >= 1; }));
-    std::printf("%-12s frames with a check under way: %d\n", motion, checking_frames);
-    EXPECT_GT(checking_frames, 0) << motion << ": the knocks were never checked";
+  std::map<std::string_view, int> checking_frames;
+  const int knocks_back = latency_knocks_back(config, forest, [&](auto motion, int i, const TrackerOutput& out, bool after_tracked) {
+    if (i == 0) {
+      EXPECT_GT(out.iterations, most_after_tracked) << motion << ": the start searches at once";
+    }
+    if (after_tracked) {
+      EXPECT_LE(out.iterations, most_after_tracked) << motion << " frame " << i << " stalls on a whole search";
+      checking_frames[motion] += out.iterations > tracking_iterations ? 1 : 0;
+    }
+  });
+  for (const auto motion : kLatencyMotions) {
+    std::printf("%-12s frames with a check under way: %d\n", std::string(motion).c_str(), checking_frames[motion]);
+    EXPECT_GT(checking_frames[motion], 0) << motion << ": the knocks were never checked";
   }
   EXPECT_GE(knocks_back, kMostKnocksBack) << "knocks repaired within 30 frames";
 }
@@ -204,24 +222,19 @@ TEST(TrackingRecovery, ChecksInTheBackgroundKeepEveryFrameShortAndStillRepairAGr
   config.background_checks = true;
   const int tracking_iterations = config.particles * config.optimizer.iterations;
   const int most_after_tracked = tracking_iterations + config.optimizer.iterations;
-  int knocks_back = 0;
-  std::mt19937_64 rng(5);
-  for (const auto motion : {"random", "flexex1", "fingercount"}) {
-    TrackingState last_state = TrackingState::kNoHand;
-    int replaced = 0;
-    const auto watch = [&](int i, const TrackerOutput& out) {
-      if (last_state == TrackingState::kTracking) {
-        EXPECT_LE(out.iterations, most_after_tracked) << motion << " frame " << i << " ran a search";
-        replaced += out.winning_particle < 0 ? 1 : 0;
-      }
-      last_state = out.state;
-    };
-    const auto recovered = knock_off_and_track(motion, config, forest, rng, watch);
-    knocks_back += static_cast<int>(std::count_if(recovered.begin(), recovered.end(), [](int f) { return f >= 1; }));
-    std::printf("%-12s tracked poses replaced by a background check's (re)start: %d\n", motion, replaced);
-    EXPECT_GT(replaced, 0) << motion << ": no background check replaced the knocked-off pose";
+  constexpr int kMostKnocksBack = 8;  // of 3 motions x 3 knocks
+  std::map<std::string_view, int> replaced;
+  const int knocks_back = latency_knocks_back(config, forest, [&](auto motion, int i, const TrackerOutput& out, bool after_tracked) {
+    if (!after_tracked) return;
+    EXPECT_LE(out.iterations, most_after_tracked) << motion << " frame " << i << " ran a search";
+    replaced[motion] += out.winning_particle < 0 ? 1 : 0;
+  });
+  for (const auto motion : kLatencyMotions) {
+    std::printf("%-12s tracked poses replaced by a background check's (re)start: %d\n", std::string(motion).c_str(),
+                replaced[motion]);
+    EXPECT_GT(replaced[motion], 0) << motion << ": no background check replaced the knocked-off pose";
   }
-  EXPECT_GE(knocks_back, 8) << "knocks repaired within 30 frames";
+  EXPECT_GE(knocks_back, kMostKnocksBack) << "knocks repaired within 30 frames";
 }
 
 // No hand: the state says so, and every number of the pose is zero (nothing invented).
