@@ -81,8 +81,8 @@ std::vector<int> knock_off_and_track(std::string_view motion, const TrackerConfi
     undisturbed_mm.push_back(eval::fingertip_error_mm(undisturbed.track(frame.depth, &forest), frame.fingertips));
     const auto out = knocked.track(frame.depth, &forest);
     knocked_mm.push_back(eval::fingertip_error_mm(out, frame.fingertips));
-    undisturbed.pose_tracker().wait_for_check();
-    knocked.pose_tracker().wait_for_check();
+    undisturbed.wait_for_checks();
+    knocked.wait_for_checks();
     if (watch) watch(i, out);
     if (std::find(kKnockFrames.begin(), kKnockFrames.end(), i) != kKnockFrames.end()) {
       auto& pose = knocked.pose_tracker();

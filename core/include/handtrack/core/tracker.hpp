@@ -383,6 +383,12 @@ class Tracker {
   // Carry on from `last` (a pose this tracker reported) at the next frame, as if it had just been
   // tracked: HandsTracker's way back for a hand hidden behind the other, instead of a (re)start.
   void resume(const TrackerOutput& last);
+  // With background checks: blocks until both hands' checks under way have finished
+  // (PoseTracker::wait_for_check; tests).
+  void wait_for_checks() {
+    right_.wait_for_check();
+    left_.wait_for_check();
+  }
 
  private:
   [[nodiscard]] const PoseTracker& side(Handedness hand) const { return hand == Handedness::kLeft ? left_ : right_; }
