@@ -2,10 +2,7 @@
 
 #include "background_search.hpp"
 
-#include <Eigen/Geometry>
-
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <numbers>
 
