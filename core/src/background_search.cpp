@@ -29,7 +29,11 @@ void become_idle_class() {
 uint64_t background_searches_finished() { return finished_searches.load(std::memory_order_relaxed); }
 
 BackgroundSearch::BackgroundSearch(const TrackerConfig& config)
-    : search_(config), scale_(config.scale), thread_([this] { run(); }) {}
+    : search_(config), scale_(config.scale), thread_([this] { run(); }) {
+  // Room for the other hand: a model's Gaussians (submit() copies one of the same size).
+  const std::lock_guard lock(mutex_);
+  other_.assign(search_.model(), PosedHand(search_.model(), PoseParams::Zero()), false);
+}
 
 BackgroundSearch::~BackgroundSearch() {
   {
@@ -45,11 +49,16 @@ BackgroundSearch::~BackgroundSearch() {
   thread_.join();
 }
 
+void BackgroundSearch::reserve(int width, int height) {
+  const std::lock_guard lock(mutex_);
+  if (state_ == State::kIdle) reserve_input(input_, width, height);
+}
+
 bool BackgroundSearch::submit(const DepthInput& input, const HandObstacle* other, const HandScale& scale) {
   {
     const std::lock_guard lock(mutex_);
     if (state_ != State::kIdle) return false;
-    input_ = input;  // storage reused from the last search: no allocation once sizes are seen
+    input_ = input;  // into the room reserve() made: no allocation
     has_other_ = other != nullptr;
     if (has_other_) other_ = *other;
     scale_ = scale;

@@ -29,6 +29,9 @@ class BackgroundSearch {
   BackgroundSearch(const BackgroundSearch&) = delete;
   BackgroundSearch& operator=(const BackgroundSearch&) = delete;
 
+  // Room for copies of inputs of a width x height image, so that submit() allocates nothing (as
+  // the daemon's steady state requires); none made while a search reads the copy.
+  void reserve(int width, int height);
   // Starts a search on copies of `input` and `other` (null: no other hand) with the hand model at
   // `scale`; false, and nothing started, while a search is under way or its result is not taken.
   bool submit(const DepthInput& input, const HandObstacle* other, const HandScale& scale);

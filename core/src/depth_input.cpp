@@ -85,6 +85,16 @@ DepthInputBuilder::DepthInputBuilder(DepthInputConfig config)
   out_.mixture.reserve(kReservedLeaves);
 }
 
+void reserve_input(DepthInput& input, int width, int height) {
+  const auto pixels = static_cast<size_t>(std::max(width, 0)) * static_cast<size_t>(std::max(height, 0));
+  input.filtered_mm.reserve(pixels);
+  input.hand_mask.reserve(pixels);
+  input.pixel_labels.reserve(pixels);
+  input.gaussians.reserve(kReservedLeaves);
+  input.mixture.reserve(kReservedLeaves);
+  input.free_space.reserve(width, height);
+}
+
 DepthInputBuilder::~DepthInputBuilder() = default;
 DepthInputBuilder::DepthInputBuilder(DepthInputBuilder&&) noexcept = default;
 DepthInputBuilder& DepthInputBuilder::operator=(DepthInputBuilder&&) noexcept = default;

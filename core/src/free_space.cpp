@@ -52,6 +52,17 @@ void FreeSpaceMap::clear() {
   cap_px_ = 0.0;
 }
 
+void FreeSpaceMap::reserve(int width, int height) {
+  // The largest box (the whole image and its ring), and the row transform's scratch: at most one
+  // entry per column of cells, and one more bound.
+  const auto most_columns = static_cast<size_t>(std::max(width, 0) / kCellPx + 3);
+  const auto most_cells = most_columns * static_cast<size_t>(std::max(height, 0) / kCellPx + 3);
+  if (distance_px_.capacity() < most_cells) distance_px_.reserve(most_cells);
+  if (scratch_.capacity() < most_cells) scratch_.reserve(most_cells);
+  if (site_.capacity() < most_columns) site_.reserve(most_columns);
+  if (bound_.capacity() < most_columns + 1) bound_.reserve(most_columns + 1);
+}
+
 void FreeSpaceMap::build(const CameraIntrinsics& camera, const std::vector<float>& depth_mm,
                          const std::vector<uint8_t>& hand_mask, const FreeSpaceConfig& config) {
   const int w = camera.width;
@@ -96,16 +107,7 @@ void FreeSpaceMap::build(const CameraIntrinsics& camera, const std::vector<float
   width_ = (std::min(w + kCellPx - 1, u_hi + reach) - u0_) / kCellPx + 1;
   height_ = (std::min(h + kCellPx - 1, v_hi + reach) - v0_) / kCellPx + 1;
   const size_t cells = static_cast<size_t>(width_) * static_cast<size_t>(height_);
-  // Room for the largest box (the whole image and its ring) up front, and the row transform's
-  // scratch: at most one entry per column of cells, and one more bound.
-  const auto most_columns = static_cast<size_t>(w / kCellPx + 3);
-  const auto most_cells = most_columns * static_cast<size_t>(h / kCellPx + 3);
-  if (distance_px_.capacity() < most_cells) distance_px_.reserve(most_cells);
-  if (scratch_.capacity() < most_cells) scratch_.reserve(most_cells);
-  if (site_.capacity() < most_columns) {
-    site_.reserve(most_columns);
-    bound_.reserve(most_columns + 1);
-  }
+  reserve(w, h);
   distance_px_.resize(cells);
   scratch_.resize(cells);
   site_.resize(static_cast<size_t>(width_));

@@ -1,6 +1,7 @@
 #include "handtrack/core/image_mixture.hpp"
 
 #include "handtrack/core/depth_input.hpp"
+#include "handtrack/core/hand_layout.hpp"
 
 #include <algorithm>
 #include <numeric>
@@ -59,6 +60,7 @@ void ImageMixture::reserve(std::size_t n) {
   by_depth_.reserve(n);
   by_label_.reserve(n);
   order_.reserve(n);
+  label_begin_.reserve(kNumPartLabels + 2);  // assign(): labels 0..kNumPartLabels
 }
 
 void ImageMixture::assign(const std::vector<ImageGaussian>& gaussians) {

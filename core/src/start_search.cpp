@@ -67,11 +67,18 @@ StartSearch::StartSearch(const TrackerConfig& config)
       model_(HandModel::default_adult(config.scale)),
       energy_(SimilarityFactor::kDepth, mode_weights(config)),
       guided_energy_(SimilarityFactor::kDepthAndLabel, mode_weights(config)),
-      optimizer_(config.optimizer) {
+      optimizer_(config.optimizer),
+      scratch_(model_, PoseParams::Zero()),
+      scale_(config.scale) {
   screened_.reserve(kMaxStarts);
 }
 
-void StartSearch::set_scale(const HandScale& scale) { model_ = HandModel::default_adult(scale); }
+void StartSearch::set_scale(const HandScale& scale) {
+  // A new model allocates: only when the scale changes (a background search sets it each time).
+  if (scale == scale_) return;
+  scale_ = scale;
+  model_ = HandModel::default_adult(scale);
+}
 
 
 StartHypothesis StartSearch::hypothesis(size_t k) {

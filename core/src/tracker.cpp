@@ -420,6 +420,9 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   bool started = false;
   CheckOutcome check = CheckOutcome::kNone;
   if (!previous_) {
+    // A (re)start: the frame of a whole search, where the background search's copies get their
+    // room once (no allocation at its first check).
+    if (background_) background_->reserve(input.camera.width, input.camera.height);
     best = search_.run(input).result;
     started = true;
     recovering_ = true;

@@ -129,6 +129,35 @@ void expect_no_steady_state_allocation(bool single_thread, const std::string& mo
   ipc::PoseRingWriter::remove(name);
 }
 
+// Background checks (TrackerConfig::background_checks) copy their frame and search it on a thread
+// of their own: neither allocates once the tracker has (re)started. The pipelines above meet a check
+// only when one happens to fall in their window, and its search only when a core is idle; here a
+// check starts every third frame and each is waited for.
+TEST(SteadyState, BackgroundChecksDoNotAllocate) {
+  TrackerConfig config;
+  config.background_checks = true;
+  config.check_interval_frames = 3;
+  config.recheck_interval_frames = 3;
+  config.recheck_below_confidence = 1.0;  // every recheck is due
+  Tracker tracker(config);
+  synth::SyntheticCamera camera(synthetic_source_options("pinch"));
+  std::vector<DepthImage> frames;
+  for (int i = 0; i < 40; ++i) frames.push_back(camera.render(i).depth);
+  const auto track = [&](int from, int to) {
+    for (int i = from; i < to; ++i) {
+      ASSERT_NE(tracker.track(frames[static_cast<size_t>(i)]).state, TrackingState::kNoHand) << "frame " << i;
+      tracker.wait_for_checks();
+    }
+  };
+  track(0, 10);  // the (re)start, its handedness trial and the first checks
+  const uint64_t searched = background_searches_finished();
+  const uint64_t before = g_allocations.load();
+  track(10, 40);
+  const uint64_t after = g_allocations.load();
+  EXPECT_GE(background_searches_finished() - searched, 5U);
+  EXPECT_EQ(after - before, 0U) << "heap allocations over 30 frames with background checks";
+}
+
 TEST(SteadyState, PipelinedDaemonDoesNotAllocate) { expect_no_steady_state_allocation(false); }
 TEST(SteadyState, SingleThreadedDaemonDoesNotAllocate) { expect_no_steady_state_allocation(true); }
 TEST(SteadyState, PipelinedDaemonWithTwoHandsDoesNotAllocate) { expect_no_steady_state_allocation(false, "two_apart"); }

@@ -84,6 +84,10 @@ struct DepthInput {
   [[nodiscard]] bool has_hand() const { return !gaussians.empty(); }
 };
 
+// Room in `input` for an input of a width x height image as DepthInputBuilder builds it, so that
+// copying one into it (operator=) allocates nothing: a background search's copy (tracker.cpp).
+void reserve_input(DepthInput& input, int width, int height);
+
 // Gives the segmented hand's pixels part labels (Sec. 4.3): the decision forest, or in tests the
 // ground-truth label image.
 class PixelLabeller {

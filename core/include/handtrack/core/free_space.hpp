@@ -46,6 +46,9 @@ class FreeSpaceMap {
   void build(const CameraIntrinsics& camera, const std::vector<float>& depth_mm, const std::vector<uint8_t>& hand_mask,
              const FreeSpaceConfig& config = {});
   void clear();
+  // Room for the map of any hand in a width x height image: build() for such images, and copies of
+  // their maps into this one, allocate nothing afterwards.
+  void reserve(int width, int height);
 
   [[nodiscard]] bool empty() const { return distance_px_.empty(); }
   [[nodiscard]] double cap_px() const { return cap_px_; }

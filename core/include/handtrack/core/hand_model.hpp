@@ -44,6 +44,7 @@ struct HandScale {
   double length = 1.0;
   double width = 1.0;
   double sigma = 1.0;
+  friend bool operator==(const HandScale&, const HandScale&) = default;
 };
 
 struct JointLimit {

@@ -29,7 +29,8 @@ class ImageMixture {
   // Rebuilds the columns from the quadtree's Gaussians (labels >= 0). Storage is reused: no
   // allocation once a frame of this size has been seen.
   void assign(const std::vector<ImageGaussian>& gaussians);
-  // Room for n Gaussians, so that assign() of up to n allocates nothing.
+  // Room for n Gaussians, so that assign() of up to n, and copying such a mixture into this one,
+  // allocate nothing.
   void reserve(std::size_t n);
 
   [[nodiscard]] std::size_t size() const { return by_depth_.depth_mm.size(); }

@@ -115,6 +115,7 @@ class StartSearch {
   PoseEnergy guided_energy_;
   AdaptiveGradientAscent optimizer_;
   PosedHand scratch_;
+  HandScale scale_;  // model_'s
   std::vector<StartFit> screened_;  // the hypotheses after screening, then the kept ones
   const HandObstacle* other_hand_ = nullptr;
   int iterations_ = 0;
