@@ -30,17 +30,15 @@ uint64_t background_searches_finished() { return finished_searches.load(std::mem
 
 BackgroundSearch::BackgroundSearch(const TrackerConfig& config)
     : search_(config), scale_(config.scale), thread_([this] { run(); }) {
-  // Room for the other hand: a model's Gaussians (submit() copies one of the same size).
-  const std::lock_guard lock(mutex_);
+  // Room for the other hand: a model's Gaussians (submit() copies one of the same size). The search
+  // thread reads other_ only once a search is queued.
   other_.assign(search_.model(), PosedHand(search_.model(), PoseParams::Zero()), false);
 }
 
 BackgroundSearch::~BackgroundSearch() {
-  {
-    const std::lock_guard lock(mutex_);
-    stop_.store(true, std::memory_order_relaxed);
-  }
-  changed_.notify_all();
+  stop_.store(true, std::memory_order_relaxed);
+  state_.store(State::kStop, std::memory_order_release);
+  state_.notify_all();
   // Back to the normal class, so that a search starved of idle time still reaches its next
   // hypothesis soon and stops.
   sched_param param{};
@@ -49,70 +47,75 @@ BackgroundSearch::~BackgroundSearch() {
   thread_.join();
 }
 
+void BackgroundSearch::reclaim_dropped() {
+  if (!wanted_ && state_.load(std::memory_order_acquire) == State::kDone) {
+    state_.store(State::kIdle, std::memory_order_release);
+  }
+}
+
 void BackgroundSearch::reserve(int width, int height) {
-  const std::lock_guard lock(mutex_);
-  if (state_ == State::kIdle) reserve_input(input_, width, height);
+  reclaim_dropped();
+  if (state_.load(std::memory_order_acquire) == State::kIdle) reserve_input(input_, width, height);
 }
 
 bool BackgroundSearch::submit(const DepthInput& input, const HandObstacle* other, const HandScale& scale) {
-  {
-    const std::lock_guard lock(mutex_);
-    if (state_ != State::kIdle) return false;
-    input_ = input;  // into the room reserve() made: no allocation
-    has_other_ = other != nullptr;
-    if (has_other_) other_ = *other;
-    scale_ = scale;
-    state_ = State::kQueued;
-  }
-  changed_.notify_all();
+  reclaim_dropped();
+  if (state_.load(std::memory_order_acquire) != State::kIdle) return false;
+  input_ = input;  // into the room reserve() made: no allocation
+  has_other_ = other != nullptr;
+  if (has_other_) other_ = *other;
+  scale_ = scale;
+  wanted_ = true;
+  state_.store(State::kQueued, std::memory_order_release);
+  state_.notify_all();
   return true;
 }
 
-bool BackgroundSearch::busy() const {
-  const std::lock_guard lock(mutex_);
-  return state_ != State::kIdle;
-}
-
 std::optional<StartFit> BackgroundSearch::take() {
-  const std::lock_guard lock(mutex_);
-  if (state_ != State::kDone) return std::nullopt;
-  state_ = State::kIdle;
-  return result_;
+  if (!wanted_ || state_.load(std::memory_order_acquire) != State::kDone) {
+    reclaim_dropped();
+    return std::nullopt;
+  }
+  StartFit fit = result_;
+  wanted_ = false;
+  state_.store(State::kIdle, std::memory_order_release);
+  return fit;
 }
 
 void BackgroundSearch::cancel() {
-  const std::lock_guard lock(mutex_);
-  if (state_ == State::kRunning) {
-    dropped_ = true;
-  } else {
-    state_ = State::kIdle;
-  }
+  wanted_ = false;
+  // Not started yet: it never starts (the search thread's own exchange then fails).
+  State queued = State::kQueued;
+  state_.compare_exchange_strong(queued, State::kIdle, std::memory_order_acq_rel);
+  reclaim_dropped();
 }
 
 void BackgroundSearch::wait() {
-  std::unique_lock lock(mutex_);
-  changed_.wait(lock, [this] { return state_ == State::kIdle || state_ == State::kDone; });
+  for (State s = state_.load(std::memory_order_acquire); s == State::kQueued || s == State::kRunning;
+       s = state_.load(std::memory_order_acquire)) {
+    state_.wait(s, std::memory_order_acquire);
+  }
 }
 
 void BackgroundSearch::run() {
   become_idle_class();
-  std::unique_lock lock(mutex_);
   for (;;) {
-    changed_.wait(lock, [this] { return state_ == State::kQueued || stop_.load(std::memory_order_relaxed); });
-    if (stop_.load(std::memory_order_relaxed)) return;
-    state_ = State::kRunning;
-    lock.unlock();
+    State s = state_.load(std::memory_order_acquire);
+    while (s != State::kQueued && s != State::kStop) {
+      state_.wait(s, std::memory_order_acquire);
+      s = state_.load(std::memory_order_acquire);
+    }
+    if (s == State::kStop) return;
+    // Cancelled (back to idle) or stopped meanwhile: nothing to search.
+    if (!state_.compare_exchange_strong(s, State::kRunning, std::memory_order_acq_rel)) continue;
     // input_, other_ and scale_ stay as submit() left them until the state is idle again.
     search_.set_scale(scale_);
     search_.set_other_hand(has_other_ ? &other_ : nullptr);
-    const StartFit fit = search_.run(input_, &stop_);
+    result_ = search_.run(input_, &stop_);
     search_.take_iterations();  // the tracking thread counts its own iterations only
-    lock.lock();
-    result_ = fit;
-    state_ = dropped_ ? State::kIdle : State::kDone;
-    dropped_ = false;
     finished_searches.fetch_add(1, std::memory_order_relaxed);
-    changed_.notify_all();
+    State running = State::kRunning;
+    if (state_.compare_exchange_strong(running, State::kDone, std::memory_order_acq_rel)) state_.notify_all();
   }
 }
 

@@ -9,14 +9,15 @@
 // as the idle CPU allows. It starts with the object, so that a tracker's threads are the same from
 // its first frame to its last (a daemon's thread count says nothing leaked).
 //
-// Thread roles: submit(), busy(), take(), cancel() and wait() from the tracking thread (one at a
-// time); the search itself on the search thread.
+// Thread roles: reserve(), submit(), take(), cancel() and wait() from the tracking thread (one at a
+// time); the search itself on the search thread. The two share no lock: they hand the search over
+// through one atomic state, so a tracking thread never waits for a thread that may not run for as
+// long as the machine is busy (a SCHED_IDLE thread preempted while holding a lock would hold it
+// that long: priority inversion).
 #include "handtrack/core/start_search.hpp"
 #include "handtrack/core/tracker.hpp"
 
 #include <atomic>
-#include <condition_variable>
-#include <mutex>
 #include <optional>
 #include <thread>
 
@@ -35,31 +36,33 @@ class BackgroundSearch {
   // Starts a search on copies of `input` and `other` (null: no other hand) with the hand model at
   // `scale`; false, and nothing started, while a search is under way or its result is not taken.
   bool submit(const DepthInput& input, const HandObstacle* other, const HandScale& scale);
-  // A search submitted and its result not yet taken (or dropped).
-  [[nodiscard]] bool busy() const;
-  // The finished search's best fit, once; nullopt while it runs, or when none was submitted.
+  // The finished search's best fit, once; nullopt while it runs, when none was submitted, or when
+  // it was cancelled.
   std::optional<StartFit> take();
-  // Drops the search under way: its result will not be taken.
+  // Drops the search submitted: one not started never starts, one under way finishes unread.
   void cancel();
   // Blocks until the search under way (if any) has finished.
   void wait();
 
  private:
-  enum class State { kIdle, kQueued, kRunning, kDone };
+  // kIdle -> kQueued (submit) -> kRunning (the search thread) -> kDone -> kIdle (take, or submit
+  // after a cancel); kQueued -> kIdle (cancel); any -> kStop (the destructor). Each store that hands
+  // data over is a release, each load that takes it an acquire.
+  enum class State { kIdle, kQueued, kRunning, kDone, kStop };
   void run();  // the search thread
+  // Finished and unwanted: back to idle (tracking thread).
+  void reclaim_dropped();
 
-  mutable std::mutex mutex_;
-  std::condition_variable changed_;
-  State state_ = State::kIdle;
-  bool dropped_ = false;  // cancel() while running: the result goes, the state back to idle
+  std::atomic<State> state_{State::kIdle};
   std::atomic<bool> stop_{false};  // the destructor: the search stops at its next hypothesis
-  // Written by submit() while idle, read by the search thread while queued or running.
+  bool wanted_ = false;            // tracking thread: the search submitted is to be taken
+  // Written by the tracking thread while idle, read by the search thread while running.
   StartSearch search_;
   DepthInput input_;
   HandObstacle other_;
   bool has_other_ = false;
   HandScale scale_;
-  StartFit result_;  // kDone
+  StartFit result_;  // written while running, read once done
   std::thread thread_;  // last: started once everything it reads is constructed
 };
 
