@@ -154,7 +154,7 @@ struct Pipeline::Impl {
   }
 
   void preprocess_loop() {
-    setup_pipeline_thread("ht-preprocess", config.pipeline.cpu[1], config.pipeline);
+    setup_pipeline_thread("ht-preprocess", config.pipeline.cpu[1], config.pipeline, StageRank::kPreprocess);
     Frame* pending = nullptr;  // preprocessed, waiting for room in input_q
     while (!stopping()) {
       const uint32_t ticket = pre_bell.ticket();
@@ -297,7 +297,10 @@ bool Pipeline::start(std::string* why) {
   const PartForest* forest = m.forest ? &*m.forest : nullptr;
   // Each stage's side thread (the second hand) shares the other stage's CPU.
   m.preprocess.emplace(m.config.tracker, *m.reload, m.request, forest, m.tally, m.watch, !m.config.single_thread,
-                       [&m] { setup_pipeline_thread("ht-preprocess-2", m.config.pipeline.cpu[2], m.config.pipeline); });
+                       [&m] {
+                         setup_pipeline_thread("ht-preprocess-2", m.config.pipeline.cpu[2], m.config.pipeline,
+                                               StageRank::kPreprocess);
+                       });
   m.optimize.emplace(m.config.tracker, *m.reload, m.request, m.watch, !m.config.single_thread,
                      [&m] { setup_pipeline_thread("ht-optimize-2", m.config.pipeline.cpu[1], m.config.pipeline); });
   m.publish.emplace(m.ring, m.tally, m.watch, m.stats);

@@ -4,12 +4,23 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <cstring>
 
 namespace handtrack::daemon {
 
-void setup_pipeline_thread(const char* name, int cpu, const PipelineConfig& config) {
+namespace {
+// Normal scheduling: the preprocessing threads' nice value above the other stages' (CFS gives a
+// thread of nice +5 a third of the weight of one of nice 0, and a waking nice-0 thread preempts it
+// sooner). SCHED_FIFO: one priority below them, which makes the order strict.
+constexpr int kPreprocessNice = 5;
+}  // namespace
+
+void setup_pipeline_thread(const char* name, int cpu, const PipelineConfig& config, StageRank rank) {
   pthread_setname_np(pthread_self(), name);
   if (cpu >= 0) {
     cpu_set_t set;
@@ -19,9 +30,16 @@ void setup_pipeline_thread(const char* name, int cpu, const PipelineConfig& conf
       log().warn("{}: cannot pin to CPU {}: {}; running unpinned", name, cpu, std::strerror(e));
     }
   }
+  const bool yields = rank == StageRank::kPreprocess;
+  if (config.realtime_priority <= 0 && yields) {
+    // Per thread on Linux (the thread id, not the process); raising one's own nice needs no privilege.
+    if (setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kPreprocessNice) != 0) {
+      log().warn("{}: cannot set nice {}: {}", name, kPreprocessNice, std::strerror(errno));
+    }
+  }
   if (config.realtime_priority > 0) {
     sched_param p{};
-    p.sched_priority = config.realtime_priority;
+    p.sched_priority = yields ? std::max(1, config.realtime_priority - 1) : config.realtime_priority;
     if (const int e = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p); e != 0) {
       log().warn("{}: cannot use SCHED_FIFO priority {}: {}; normal scheduling", name, config.realtime_priority,
                  std::strerror(e));

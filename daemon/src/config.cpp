@@ -106,7 +106,9 @@ const std::vector<Field>& fields() {
     {"pipeline.cpu_publish", IntRef{[](DaemonConfig& c) -> int& { return c.pipeline.cpu[3]; }}, -1, 1023,
      "CPU the publish thread is pinned to (-1: any)", false},
     {"pipeline.realtime_priority", IntRef{[](DaemonConfig& c) -> int& { return c.pipeline.realtime_priority; }}, 0, 99,
-     "SCHED_FIFO priority of the stage threads (0: normal scheduling; needs CAP_SYS_NICE)", false},
+     "SCHED_FIFO priority of the stage threads, the preprocessing ones one below (0: normal scheduling, "
+     "preprocessing at nice 5; needs CAP_SYS_NICE)",
+     false},
     {"pipeline.stall_timeout_ms", IntRef{[](DaemonConfig& c) -> int& { return c.pipeline.stall_timeout_ms; }}, 100, 600000,
      "a stage busy on one frame this long counts as stalled: watchdog pings and heartbeats stop", false},
     {"pipeline.stats_interval_ms", IntRef{[](DaemonConfig& c) -> int& { return c.pipeline.stats_interval_ms; }}, 100, 60000,

@@ -12,9 +12,14 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
+#include <sstream>
+#include <string>
 #include <thread>
 
 namespace handtrack::daemon {
@@ -165,6 +170,48 @@ TEST(Pipeline, TwoHandsArePublishedTogetherEachWithItsOwnTimes) {
     }
   }
   EXPECT_GE(both, 58) << "of 60 frames with both hands";
+}
+
+// The nice value of each of this process's threads, by name (/proc/self/task/TID/stat: the
+// 19th field, counted after the name's closing parenthesis).
+std::map<std::string, int> thread_nice_values() {
+  std::map<std::string, int> out;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::ifstream comm(task.path() / "comm");
+    std::ifstream stat(task.path() / "stat");
+    std::string name;
+    std::string line;
+    if (!std::getline(comm, name) || !std::getline(stat, line)) continue;  // a thread that ended
+    std::istringstream fields(line.substr(line.rfind(')') + 2));
+    std::string field;
+    for (int k = 3; k <= 19 && fields >> field; ++k) {
+      if (k == 19) out[name] = std::stoi(field);
+    }
+  }
+  return out;
+}
+
+// Where two stage threads share a CPU (each stage's second-hand thread runs on the other stage's
+// CPU), the next frame's preprocessing yields to this frame's optimisation: its threads run at a
+// higher nice value than the optimize threads (docs/THREADING.md).
+TEST(Pipeline, NextFramesPreprocessingYieldsToThisFramesOptimisation) {
+  DaemonConfig config;
+  config.fast = true;
+  auto options = synthetic_source_options("two_apart");
+  constexpr uint64_t kFrames = 20;
+  options.frames = static_cast<int>(kFrames);
+  auto camera = std::make_shared<synth::SyntheticCamera>(options);
+  std::map<std::string, int> nice;
+  run_to_end(config, std::make_unique<ScriptedSource>(kFrames, false, [&](uint64_t i, RawFrame& f) {
+               if (i == kFrames - 1) nice = thread_nice_values();  // every stage thread has set itself up
+               to_raw(camera->render(static_cast<int>(i)).depth, f);
+             }));
+  for (const char* name : {"ht-preprocess", "ht-preprocess-2", "ht-optimize", "ht-optimize-2", "ht-grab"}) {
+    ASSERT_EQ(nice.count(name), 1U) << name << " not running";
+  }
+  EXPECT_GT(nice["ht-preprocess"], nice["ht-optimize-2"]) << "they share a CPU";
+  EXPECT_GT(nice["ht-preprocess-2"], nice["ht-optimize"]) << "they share a CPU";
+  EXPECT_EQ(nice["ht-optimize"], nice["ht-grab"]) << "only preprocessing yields";
 }
 
 TEST(Pipeline, FramesWithoutDepthInTheWorkingVolumeAreNoHandAndCounted) {

@@ -40,7 +40,7 @@ struct PipelineConfig {
   int pool_frames = 0;           // 0: enough for every queue and stage (computed)
   // -1: any CPU; otherwise the CPU a stage's thread is pinned to (grab, preprocess, optimize, publish).
   std::array<int, kNumStages> cpu{-1, -1, -1, -1};
-  int realtime_priority = 0;     // SCHED_FIFO priority of the stage threads, 0 = normal scheduling
+  int realtime_priority = 0;     // SCHED_FIFO priority of the stage threads (preprocessing: one below), 0 = normal scheduling
   int stall_timeout_ms = 2000;   // a stage busy on one frame this long is stalled: watchdog pings stop
   int stats_interval_ms = 1000;  // statistics into the ring header, STATUS= and the debug summary
 };
