@@ -140,19 +140,25 @@ TEST(Pipeline, ResolutionChangeMidStreamRebuildsBuffersAndKeepsTracking) {
 }
 
 // Two hands (issue 14): the synthetic two_apart scene through the whole pipeline, every frame
-// tracked (fast); both hands are published in each frame, each with its own optimize time, and the
-// two keep their ids.
-TEST(Pipeline, TwoHandsArePublishedTogetherEachWithItsOwnTimes) {
+// tracked (fast). `at_grab` (may be empty) runs on the grab thread before each frame is rendered.
+RunResult run_two_hands(uint64_t frames, const std::function<void(uint64_t)>& at_grab = {}) {
   DaemonConfig config;
   config.fast = true;
   auto options = synthetic_source_options("two_apart");
-  constexpr uint64_t kFrames = 60;
-  options.frames = static_cast<int>(kFrames);
+  options.frames = static_cast<int>(frames);
   auto camera = std::make_shared<synth::SyntheticCamera>(options);
-  const RunResult run = run_to_end(
-      config, std::make_unique<ScriptedSource>(kFrames, false, [camera](uint64_t i, RawFrame& f) {
-        to_raw(camera->render(static_cast<int>(i)).depth, f);
-      }));
+  return run_to_end(config,
+                    std::make_unique<ScriptedSource>(frames, false, [camera, at_grab](uint64_t i, RawFrame& f) {
+                      if (at_grab) at_grab(i);
+                      to_raw(camera->render(static_cast<int>(i)).depth, f);
+                    }));
+}
+
+// Both hands are published in each frame, each with its own optimize time, and the two keep their
+// ids.
+TEST(Pipeline, TwoHandsArePublishedTogetherEachWithItsOwnTimes) {
+  constexpr uint64_t kFrames = 60;
+  const RunResult run = run_two_hands(kFrames);
   ASSERT_EQ(run.records.size(), kFrames);
   std::array<uint32_t, 2> ids{};
   int both = 0;
@@ -195,17 +201,11 @@ std::map<std::string, int> thread_nice_values() {
 // CPU), the next frame's preprocessing yields to this frame's optimisation: its threads run at a
 // higher nice value than the optimize threads (docs/THREADING.md).
 TEST(Pipeline, NextFramesPreprocessingYieldsToThisFramesOptimisation) {
-  DaemonConfig config;
-  config.fast = true;
-  auto options = synthetic_source_options("two_apart");
   constexpr uint64_t kFrames = 20;
-  options.frames = static_cast<int>(kFrames);
-  auto camera = std::make_shared<synth::SyntheticCamera>(options);
   std::map<std::string, int> nice;
-  run_to_end(config, std::make_unique<ScriptedSource>(kFrames, false, [&](uint64_t i, RawFrame& f) {
-               if (i == kFrames - 1) nice = thread_nice_values();  // every stage thread has set itself up
-               to_raw(camera->render(static_cast<int>(i)).depth, f);
-             }));
+  run_two_hands(kFrames, [&](uint64_t i) {
+    if (i == kFrames - 1) nice = thread_nice_values();  // every stage thread has set itself up
+  });
   for (const char* name : {"ht-preprocess", "ht-preprocess-2", "ht-optimize", "ht-optimize-2", "ht-grab"}) {
     ASSERT_EQ(nice.count(name), 1U) << name << " not running";
   }
