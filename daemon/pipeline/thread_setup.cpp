@@ -14,9 +14,9 @@
 namespace handtrack::daemon {
 
 namespace {
-// Normal scheduling: the preprocessing threads' nice value above the other stages' (CFS gives a
-// thread of nice +5 a third of the weight of one of nice 0, and a waking nice-0 thread preempts it
-// sooner). SCHED_FIFO: one priority below them, which makes the order strict.
+// Normal scheduling: the preprocessing threads' nice value this much above the other stages'
+// (CFS gives a thread of nice +5 a third of the weight of one of nice 0, and a waking nice-0
+// thread preempts it sooner). SCHED_FIFO: one priority below them, which makes the order strict.
 constexpr int kPreprocessNice = 5;
 }  // namespace
 
@@ -32,9 +32,14 @@ void setup_pipeline_thread(const char* name, int cpu, const PipelineConfig& conf
   }
   const bool yields = rank == StageRank::kPreprocess;
   if (config.realtime_priority <= 0 && yields) {
-    // Per thread on Linux (the thread id, not the process); raising one's own nice needs no privilege.
-    if (setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kPreprocessNice) != 0) {
-      log().warn("{}: cannot set nice {}: {}", name, kPreprocessNice, std::strerror(errno));
+    // Per thread on Linux (the thread id, not the process), above the nice the daemon runs at;
+    // raising one's own nice needs no privilege. getpriority() may return -1 as a value: errno
+    // tells.
+    const auto self = static_cast<id_t>(gettid());
+    errno = 0;
+    const int nice = getpriority(PRIO_PROCESS, self) + kPreprocessNice;
+    if (errno != 0 || setpriority(PRIO_PROCESS, self, nice) != 0) {
+      log().warn("{}: cannot lower its priority: {}", name, std::strerror(errno));
     }
   }
   if (config.realtime_priority > 0) {

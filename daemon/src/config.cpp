@@ -107,7 +107,7 @@ const std::vector<Field>& fields() {
      "CPU the publish thread is pinned to (-1: any)", false},
     {"pipeline.realtime_priority", IntRef{[](DaemonConfig& c) -> int& { return c.pipeline.realtime_priority; }}, 0, 99,
      "SCHED_FIFO priority of the stage threads, the preprocessing ones one below (0: normal scheduling, "
-     "preprocessing at nice 5; needs CAP_SYS_NICE)",
+     "preprocessing at a nice value 5 higher; needs CAP_SYS_NICE)",
      false},
     {"pipeline.stall_timeout_ms", IntRef{[](DaemonConfig& c) -> int& { return c.pipeline.stall_timeout_ms; }}, 100, 600000,
      "a stage busy on one frame this long counts as stalled: watchdog pings and heartbeats stop", false},
