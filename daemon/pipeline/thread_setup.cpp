@@ -46,7 +46,7 @@ void setup_pipeline_thread(const char* name, int cpu, const PipelineConfig& conf
     sched_param p{};
     p.sched_priority = yields ? std::max(1, config.realtime_priority - 1) : config.realtime_priority;
     if (const int e = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p); e != 0) {
-      log().warn("{}: cannot use SCHED_FIFO priority {}: {}; normal scheduling", name, config.realtime_priority,
+      log().warn("{}: cannot use SCHED_FIFO priority {}: {}; normal scheduling", name, p.sched_priority,
                  std::strerror(e));
     }
   }
