@@ -20,18 +20,20 @@ constexpr double kTwoPi = 2.0 * std::numbers::pi;
 // Slices are widened by this much so that the exact test |d_p - d_q| < reach decides at the edge.
 constexpr double kSliceMarginMm = 1e-6;
 
-// A model Gaussian projected to the image (Sec. 3.2): mean (px), sigma_p^2 (px^2), d_p (mm), and
-// the depth factor's reach (mm).
+// A model Gaussian projected to the image (Sec. 3.2): mean (px), sigma_p (px) and sigma_p^2, d_p
+// (mm), and the depth factor's reach (mm).
 struct ProjectedGaussian {
   double u = 0.0;
   double v = 0.0;
+  double sigma = 0.0;
   double sigma2 = 0.0;
   double depth_mm = 0.0;
   double reach_mm = 1.0;
 };
 
 // The sums over image Gaussians q that E_sim and its gradient need for one model Gaussian p, with
-// D = D_pq, S = sigma_p^2 + sigma_q^2, r^2 = |mu_p - mu_q|^2 (see energy.hpp):
+// D = D_pq, S = sigma_p^2 + sigma_q^2, r^2 = |mu_p - mu_q|^2 (see energy.hpp), over the q that are
+// open (below their coverage cap; all without one):
 struct PairSums {
   double overlap = 0.0;     // sum Delta D
   double weight = 0.0;      // sum Delta D / S
@@ -43,13 +45,15 @@ struct PairSums {
 
 // Branch-free so that gcc vectorises it: 2 doubles per SSE2 register on any x86-64, 4 with fused
 // multiply-adds in the x86-64-v3 (AVX2, FMA) clone, which the loader picks on CPUs that have it.
-HANDTRACK_TARGET_CLONES PairSums pair_sums(const ProjectedGaussian& p,
-                                                                               const ImageMixtureSlice& q) {
+// `open`: 1 or 0 per Gaussian of the slice.
+HANDTRACK_TARGET_CLONES PairSums pair_sums(const ProjectedGaussian& p, const ImageMixtureSlice& q,
+                                           const double* open) {
   // Everything the loop reads in locals: gcc then sees unit-stride loads, not gathers.
   const double* const q_u = q.u;
   const double* const q_v = q.v;
   const double* const q_sigma2 = q.sigma2;
   const double* const q_depth = q.depth_mm;
+  const double* const q_open = open;
   const std::size_t n = q.size;
   const double u = p.u;
   const double v = p.v;
@@ -67,7 +71,7 @@ HANDTRACK_TARGET_CLONES PairSums pair_sums(const ProjectedGaussian& p,
   for (std::size_t k = 0; k < n; ++k) {
     const double depth_diff = depth - q_depth[k];
     const double abs_diff = std::abs(depth_diff);
-    const double in_reach = abs_diff < reach ? 1.0 : 0.0;
+    const double in_reach = abs_diff < reach ? q_open[k] : 0.0;
     const double delta = in_reach * (1.0 - abs_diff * inv_reach);
     const double du = u - q_u[k];
     const double dv = v - q_v[k];
@@ -83,6 +87,30 @@ HANDTRACK_TARGET_CLONES PairSums pair_sums(const ProjectedGaussian& p,
     depth_sign += depth_diff > 0.0 ? in_reach * d : -in_reach * d;
   }
   return {overlap, weight, weight_du, weight_dv, weight_r2, depth_sign};
+}
+
+// covered[k] += Delta D_pq for each Gaussian q = k of the slice: the first pass of a capped E_sim.
+HANDTRACK_TARGET_CLONES void add_overlaps(const ProjectedGaussian& p, const ImageMixtureSlice& q, double* covered) {
+  const double* const q_u = q.u;
+  const double* const q_v = q.v;
+  const double* const q_sigma2 = q.sigma2;
+  const double* const q_depth = q.depth_mm;
+  const std::size_t n = q.size;
+  const double u = p.u;
+  const double v = p.v;
+  const double sigma2 = p.sigma2;
+  const double depth = p.depth_mm;
+  const double reach = p.reach_mm;
+  const double inv_reach = 1.0 / reach;
+#pragma omp simd
+  for (std::size_t k = 0; k < n; ++k) {
+    const double abs_diff = std::abs(depth - q_depth[k]);
+    const double delta = abs_diff < reach ? 1.0 - abs_diff * inv_reach : 0.0;
+    const double du = u - q_u[k];
+    const double dv = v - q_v[k];
+    const double inv_s = 1.0 / (sigma2 + q_sigma2[k]);
+    covered[k] += delta * kTwoPi * sigma2 * q_sigma2[k] * inv_s * detail::exp_nonpositive(-0.5 * (du * du + dv * dv) * inv_s);
+  }
 }
 
 // The 3D overlap of eq. 8 for one pair of isotropic Gaussians, E_col's and E_hand's, from the
@@ -194,29 +222,59 @@ double SimilarityTerm::evaluate_centres(const HandModel& model, const PosedHand&
   const double f = cam.focal();
   const double inv_norm = 1.0 / input.self_similarity;
   const auto& gaussians = model.gaussians();
-  double energy = 0.0;
+  const bool capped = coverage_cap_ > 0.0;
+  const bool by_label = factor_ == SimilarityFactor::kLabel;
+  // S_q (with a cap), and 1 where q is open (below its cap: its pairs count), 0 where not.
+  const std::size_t n = input.mixture.size();
+  const ImageMixture::Coverage coverage = input.mixture.coverage_scratch();
+  std::fill_n(coverage.open, n, 1.0);
+  if (capped) std::fill_n(coverage.covered, n, 0.0);
+  // Each model Gaussian projected: u = fx x/z + cx, v = fy y/z + cy, sigma_p = sigma_h f/z,
+  // d_p = z - sigma_h; with a cap, its overlaps added to the coverage S_q.
+  std::array<ProjectedGaussian, kMaxModelGaussians> projected;
+  std::array<ImageMixtureSlice, kMaxModelGaussians> slices{};
   for (int i = 0; i < hand.gaussian_count(); ++i) {
     const Vector3d& mu = hand.centre(i);
     const double z = mu.z();
     if (z < 1.0) continue;  // behind or at the camera: no projection
     const auto& g = gaussians[static_cast<size_t>(i)];
     const double sigma_h = g.sigma_mm;
-    // Projection: u = fx x/z + cx, v = fy y/z + cy, sigma_p = sigma_h f/z, d_p = z - sigma_h.
-    ProjectedGaussian p;
+    ProjectedGaussian& p = projected[static_cast<size_t>(i)];
     p.u = cam.fx * mu.x() / z + cam.cx;
     p.v = cam.fy * mu.y() / z + cam.cy;
-    const double sp = sigma_h * f / z;
-    p.sigma2 = sp * sp;
+    p.sigma = sigma_h * f / z;
+    p.sigma2 = p.sigma * p.sigma;
     p.depth_mm = z - sigma_h;
-    p.reach_mm = factor_ == SimilarityFactor::kLabel ? 2.0 * label_radius_mm_ : 2.0 * sigma_h;
+    p.reach_mm = by_label ? 2.0 * label_radius_mm_ : 2.0 * sigma_h;
     const double lo = p.depth_mm - p.reach_mm - kSliceMarginMm;
     const double hi = p.depth_mm + p.reach_mm + kSliceMarginMm;
-    const ImageMixtureSlice slice = factor_ == SimilarityFactor::kLabel ? input.mixture.label_slice(g.label, lo, hi)
-                                                                        : input.mixture.depth_slice(lo, hi);
+    ImageMixtureSlice& slice = slices[static_cast<size_t>(i)];
+    slice = by_label ? input.mixture.label_slice(g.label, lo, hi) : input.mixture.depth_slice(lo, hi);
+    if (capped && slice.size > 0) add_overlaps(p, slice, coverage.covered + slice.first);
+  }
+  double energy = 0.0;
+  if (capped) {
+    // sum_q min(S_q, c D_qq); a q at its cap is closed: its pairs leave the gradient's sums.
+    const double* sigma2 = by_label ? input.mixture.sigma2_by_label() : input.mixture.sigma2_by_depth();
+    for (std::size_t k = 0; k < n; ++k) {
+      const double cap = coverage_cap_ * std::numbers::pi * sigma2[k];
+      const bool open = coverage.covered[k] < cap;
+      energy += open ? coverage.covered[k] : cap;
+      coverage.open[k] = open ? 1.0 : 0.0;
+    }
+    if (dE_dcentres == nullptr) return energy * inv_norm;
+  }
+  for (int i = 0; i < hand.gaussian_count(); ++i) {
+    const ImageMixtureSlice& slice = slices[static_cast<size_t>(i)];
     if (slice.size == 0) continue;
-    const PairSums sums = pair_sums(p, slice);
-    energy += sums.overlap;
+    const ProjectedGaussian& p = projected[static_cast<size_t>(i)];
+    const PairSums sums = pair_sums(p, slice, coverage.open + slice.first);
+    if (!capped) energy += sums.overlap;
     if (dE_dcentres == nullptr) continue;
+    const Vector3d& mu = hand.centre(i);
+    const double z = mu.z();
+    const double sigma_h = gaussians[static_cast<size_t>(i)].sigma_mm;
+    const double sp = p.sigma;
     const double de_du = -sums.weight_du;
     const double de_dv = -sums.weight_dv;
     const double de_ds = sums.overlap * 2.0 / sp - 2.0 * sp * sums.weight + sp * sums.weight_r2;
@@ -412,7 +470,8 @@ double SmoothnessTerm::evaluate(const PoseParams& params, const PoseParams& prev
 PoseEnergy::PoseEnergy(SimilarityFactor factor, const EnergyWeights& weights, double label_share)
     : factor_(factor),
       weights_(weights),
-      similarity_(factor == SimilarityFactor::kDepthAndLabel ? SimilarityFactor::kDepth : factor, weights.label_radius_mm),
+      similarity_(factor == SimilarityFactor::kDepthAndLabel ? SimilarityFactor::kDepth : factor, weights.label_radius_mm,
+                  factor == SimilarityFactor::kLabel ? 0.0 : weights.coverage_cap),
       label_similarity_(SimilarityFactor::kLabel, weights.label_radius_mm),
       label_share_(label_share),
       smoothness_(weights.smoothness_translation_per_mm) {}

@@ -46,7 +46,7 @@ ImageMixtureSlice ImageMixture::Columns::slice(std::size_t begin, std::size_t en
   const double* hi = partition_point(lo, static_cast<std::size_t>(depth_mm.data() + end - lo),
                                      [&](double d) { return d <= hi_mm; });
   const auto i = static_cast<std::size_t>(lo - depth_mm.data());
-  return {u.data() + i, v.data() + i, sigma2.data() + i, depth_mm.data() + i, static_cast<std::size_t>(hi - lo)};
+  return {u.data() + i, v.data() + i, sigma2.data() + i, depth_mm.data() + i, static_cast<std::size_t>(hi - lo), i};
 }
 
 void ImageMixture::Columns::reserve(std::size_t n) {
@@ -60,6 +60,8 @@ void ImageMixture::reserve(std::size_t n) {
   by_depth_.reserve(n);
   by_label_.reserve(n);
   order_.reserve(n);
+  covered_.reserve(n);
+  open_.reserve(n);
   label_begin_.reserve(kNumPartLabels + 2);  // assign(): labels 0..kNumPartLabels
 }
 
@@ -68,6 +70,8 @@ void ImageMixture::assign(const std::vector<ImageGaussian>& gaussians) {
   by_depth_.resize(n);
   by_label_.resize(n);
   order_.resize(n);
+  covered_.resize(n);
+  open_.resize(n);
   std::iota(order_.begin(), order_.end(), std::size_t{0});
   const auto depth = [&](std::size_t i) { return gaussians[i].depth_mm; };
   std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return depth(a) < depth(b); });

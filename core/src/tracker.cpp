@@ -342,10 +342,13 @@ TrackerOutput Tracker::track(const DepthImage& depth, const PixelLabeller* label
 
 // Depth-only tracking runs the paper's eq. 2: with E_free it lost the fists of fingercount and the
 // fast half of random (the palm-view Dexter motions, 7 subjects: 13.2 -> 17.2 mm; docs/TRACKER.md
-// "Free space").
+// "Free space"), and E_sim is eq. 6's, without the coverage cap.
 EnergyWeights mode_weights(const TrackerConfig& config) {
   EnergyWeights weights = config.weights;
-  if (config.mode == EnergyMode::kDepthOnly) weights.free_space = 0.0;
+  if (config.mode == EnergyMode::kDepthOnly) {
+    weights.free_space = 0.0;
+    weights.coverage_cap = 0.0;
+  }
   return weights;
 }
 

@@ -138,6 +138,15 @@ TEST_P(EnergyGradient, EveryTermMatchesFiniteDifferences) {
         return label_sim.evaluate(model, hand, input, g);
       },
       pose, "E_sim (label)");
+  // With the coverage cap: a kink where an image Gaussian reaches its cap, which a difference step
+  // straddles about as rarely as the depth factor's.
+  const SimilarityTerm capped_sim(SimilarityFactor::kDepth, 200.0, EnergyWeights{}.coverage_cap);
+  expect_gradient_matches(
+      [&](const PoseParams& p, PoseGradient* g) {
+        hand.update(model, p);
+        return capped_sim.evaluate(model, hand, input, g);
+      },
+      pose, "E_sim (depth, capped)");
   const CollisionTerm col;
   expect_gradient_matches(
       [&](const PoseParams& p, PoseGradient* g) {
@@ -304,7 +313,7 @@ TEST(EnergyTerms, NoOtherHandLeavesTheEnergyBitIdentical) {
     EXPECT_EQ(parts.inter_hand, 0.0);
     // Eq. 2 from the terms, in PoseEnergy's order.
     hand.update(model, pose);
-    const SimilarityTerm similarity(SimilarityFactor::kDepth, weights.label_radius_mm);
+    const SimilarityTerm similarity(SimilarityFactor::kDepth, weights.label_radius_mm, weights.coverage_cap);
     const double sim = similarity.evaluate(model, hand, input, nullptr);
     const double col = CollisionTerm().evaluate(model, hand, nullptr);
     const double lim = JointLimitTerm().evaluate(model, pose, nullptr);

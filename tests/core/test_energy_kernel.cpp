@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace handtrack {
@@ -47,27 +48,37 @@ TEST_F(EnergyKernel, InputsAreRealisticHands) {
 TEST_F(EnergyKernel, SameEnergyAndGradientAsTheReference) {
   PosedHand hand;
   int compared = 0;
-  for (const SimilarityFactor factor : {SimilarityFactor::kDepth, SimilarityFactor::kLabel}) {
-    const SimilarityTerm term(factor, kLabelRadiusMm);
-    for (const auto& c : cases()) {
-      for (size_t k = 0; k < c.poses.size(); ++k) {
-        hand.update(model_, c.poses[k]);
-        PoseGradient expected = PoseGradient::Zero();
-        PoseGradient actual = PoseGradient::Zero();
-        const double e_ref = reference::similarity(model_, hand, c.input, factor, kLabelRadiusMm, &expected);
-        const double e_opt = term.evaluate(model_, hand, c.input, &actual);
-        const char* name = factor == SimilarityFactor::kDepth ? "depth factor" : "label factor";
-        if (k == 0) {
-          EXPECT_GT(e_ref, 0.1) << name << ": at the true pose the model overlaps the image";
+  int capped_pairs = 0;  // evaluations where the cap closed some image Gaussians
+  for (const double cap : {0.0, EnergyWeights{}.coverage_cap}) {
+    for (const SimilarityFactor factor : {SimilarityFactor::kDepth, SimilarityFactor::kLabel}) {
+      const SimilarityTerm term(factor, kLabelRadiusMm, cap);
+      for (const auto& c : cases()) {
+        for (size_t k = 0; k < c.poses.size(); ++k) {
+          hand.update(model_, c.poses[k]);
+          PoseGradient expected = PoseGradient::Zero();
+          PoseGradient actual = PoseGradient::Zero();
+          const double e_ref = reference::similarity(model_, hand, c.input, factor, kLabelRadiusMm, &expected, cap);
+          const double e_opt = term.evaluate(model_, hand, c.input, &actual);
+          const std::string name = std::string(factor == SimilarityFactor::kDepth ? "depth factor" : "label factor") +
+                                   ", cap " + std::to_string(cap) + ", pose " + std::to_string(k);
+          if (k == 0) {
+            EXPECT_GT(e_ref, 0.1) << name << ": at the true pose the model overlaps the image";
+          }
+          if (cap > 0.0) {
+            const double uncapped = reference::similarity(model_, hand, c.input, factor, kLabelRadiusMm, nullptr);
+            EXPECT_LE(e_ref, uncapped * (1.0 + 1e-12)) << name;
+            capped_pairs += e_ref < uncapped * (1.0 - 1e-9) ? 1 : 0;
+          }
+          EXPECT_NEAR(e_opt, e_ref, 1e-6 * std::abs(e_ref)) << name;
+          EXPECT_LE((actual - expected).norm(), 1e-6 * expected.norm()) << name;
+          EXPECT_EQ(term.evaluate(model_, hand, c.input, nullptr), e_opt) << "the energy does not depend on the gradient";
+          ++compared;
         }
-        EXPECT_NEAR(e_opt, e_ref, 1e-6 * std::abs(e_ref)) << name << ", pose " << k;
-        EXPECT_LE((actual - expected).norm(), 1e-6 * expected.norm()) << name << ", pose " << k;
-        EXPECT_EQ(term.evaluate(model_, hand, c.input, nullptr), e_opt) << "the energy does not depend on the gradient";
-        ++compared;
       }
     }
   }
-  EXPECT_EQ(compared, 2 * 7 * 8);
+  EXPECT_EQ(compared, 2 * 2 * 7 * 8);
+  EXPECT_GT(capped_pairs, 7 * 8 / 2) << "the cap must bind in most evaluations for the comparison to test it";
 }
 
 // The kinematic chain for all centres at once equals the per-point chain summed.

@@ -86,7 +86,8 @@ TEST(TrackingAccuracy, SevenSyntheticMotionsDepthOnlyAndLateFusion2Particles10It
   std::vector<eval::SequenceScore> late_fusion;
   std::vector<eval::SequenceScore> shipped;
   TrackerConfig paper_fusion = testing::paper_config(EnergyMode::kLateFusion);
-  paper_fusion.weights.free_space = 0.0;
+  paper_fusion.weights.free_space = 0.0;  // the paper's energy: eq. 2 with eq. 6's E_sim
+  paper_fusion.weights.coverage_cap = 0.0;
   for (const uint64_t seed : testing::kSubjectSeeds) {
     for (const auto motion : synth::kMotionNames) {
       auto camera = testing::motion_camera(motion, seed);

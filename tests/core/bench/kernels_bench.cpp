@@ -102,9 +102,10 @@ void BM_ForestLabels(benchmark::State& state) {
 }
 BENCHMARK(BM_ForestLabels)->Unit(benchmark::kMicrosecond);
 
-// E_sim and its gradient for one posed model: the optimised term (Arg 0 depth, 1 label factor).
+// E_sim and its gradient for one posed model: the optimised term (label: 0 depth, 1 label factor;
+// capped: with the shipped coverage cap, two passes, or eq. 6's one).
 void BM_Similarity(benchmark::State& state) {
-  const SimilarityTerm term(factor_of(state), kLabelRadiusMm);
+  const SimilarityTerm term(factor_of(state), kLabelRadiusMm, state.range(1) != 0 ? EnergyWeights{}.coverage_cap : 0.0);
   size_t i = 0;
   for (auto _ : state) {
     const auto& c = posed_cases()[i];
@@ -114,7 +115,7 @@ void BM_Similarity(benchmark::State& state) {
     i = (i + 1) % posed_cases().size();
   }
 }
-BENCHMARK(BM_Similarity)->ArgName("label")->Arg(0)->Arg(1);
+BENCHMARK(BM_Similarity)->ArgNames({"label", "capped"})->Args({0, 0})->Args({1, 0})->Args({0, 1});
 
 // The same with the plain reference (every pair, libm exp, the chain one point at a time).
 void BM_SimilarityReference(benchmark::State& state) {

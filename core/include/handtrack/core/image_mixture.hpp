@@ -22,6 +22,7 @@ struct ImageMixtureSlice {
   const double* sigma2 = nullptr;
   const double* depth_mm = nullptr;
   std::size_t size = 0;
+  std::size_t first = 0;  // the index of its first Gaussian in its ordering (by depth, or by label)
 };
 
 class ImageMixture {
@@ -38,6 +39,19 @@ class ImageMixture {
   [[nodiscard]] ImageMixtureSlice depth_slice(double lo_mm, double hi_mm) const;
   // The image Gaussians with part label `label` and lo_mm <= d_q <= hi_mm.
   [[nodiscard]] ImageMixtureSlice label_slice(int label, double lo_mm, double hi_mm) const;
+  // sigma_q^2 of all size() Gaussians in the order of depth_slice()'s, resp. label_slice()'s,
+  // slices: a slice's Gaussian k is Gaussian first + k here.
+  [[nodiscard]] const double* sigma2_by_depth() const { return by_depth_.sigma2.data(); }
+  [[nodiscard]] const double* sigma2_by_label() const { return by_label_.sigma2.data(); }
+
+  // Scratch of a capped E_sim (SimilarityTerm): two columns of size() values, sized with the
+  // Gaussians, so that no evaluation allocates. Each evaluation overwrites them: a mixture is
+  // evaluated by one thread at a time (each hand, each search has a DepthInput of its own).
+  struct Coverage {
+    double* covered = nullptr;
+    double* open = nullptr;
+  };
+  [[nodiscard]] Coverage coverage_scratch() const { return {covered_.data(), open_.data()}; }
 
  private:
   struct Columns {
@@ -52,6 +66,8 @@ class ImageMixture {
   Columns by_label_;
   std::vector<std::size_t> label_begin_;  // label l is by_label_[label_begin_[l], label_begin_[l + 1])
   std::vector<std::size_t> order_;        // scratch for sorting
+  mutable std::vector<double> covered_;   // coverage_scratch()
+  mutable std::vector<double> open_;
 };
 
 }  // namespace handtrack
