@@ -140,7 +140,7 @@ TEST_P(EnergyGradient, EveryTermMatchesFiniteDifferences) {
       pose, "E_sim (label)");
   // With the coverage cap: a kink where an image Gaussian reaches its cap, which a difference step
   // straddles about as rarely as the depth factor's.
-  const SimilarityTerm capped_sim(SimilarityFactor::kDepth, 200.0, EnergyWeights{}.coverage_cap);
+  const SimilarityTerm capped_sim(SimilarityFactor::kDepth, 200.0, kMeasuredCoverageCap);
   expect_gradient_matches(
       [&](const PoseParams& p, PoseGradient* g) {
         hand.update(model, p);

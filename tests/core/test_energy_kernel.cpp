@@ -49,7 +49,7 @@ TEST_F(EnergyKernel, SameEnergyAndGradientAsTheReference) {
   PosedHand hand;
   int compared = 0;
   int capped_pairs = 0;  // evaluations where the cap closed some image Gaussians
-  for (const double cap : {0.0, EnergyWeights{}.coverage_cap}) {
+  for (const double cap : {0.0, kMeasuredCoverageCap}) {
     for (const SimilarityFactor factor : {SimilarityFactor::kDepth, SimilarityFactor::kLabel}) {
       const SimilarityTerm term(factor, kLabelRadiusMm, cap);
       for (const auto& c : cases()) {

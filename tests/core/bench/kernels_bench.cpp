@@ -105,7 +105,7 @@ BENCHMARK(BM_ForestLabels)->Unit(benchmark::kMicrosecond);
 // E_sim and its gradient for one posed model: the optimised term (label: 0 depth, 1 label factor;
 // capped: with the shipped coverage cap, two passes, or eq. 6's one).
 void BM_Similarity(benchmark::State& state) {
-  const SimilarityTerm term(factor_of(state), kLabelRadiusMm, state.range(1) != 0 ? EnergyWeights{}.coverage_cap : 0.0);
+  const SimilarityTerm term(factor_of(state), kLabelRadiusMm, state.range(1) != 0 ? kMeasuredCoverageCap : 0.0);
   size_t i = 0;
   for (auto _ : state) {
     const auto& c = posed_cases()[i];
