@@ -43,24 +43,60 @@ struct PairSums {
   double depth_sign = 0.0;  // sum over |d_p - d_q| < reach of D sign(d_p - d_q)
 };
 
-// Branch-free so that gcc vectorises it: 2 doubles per SSE2 register on any x86-64, 4 with fused
-// multiply-adds in the x86-64-v3 (AVX2, FMA) clone, which the loader picks on CPUs that have it.
-// `open`: 1 or 0 per Gaussian of the slice.
+// One model Gaussian p against the Gaussians q of a slice, with everything the loops below read in
+// members that the compiler keeps in registers: it then sees unit-stride loads, not gathers. at(k)
+// is one pair q = k, branch-free:
+//   Delta = 1 - |d_p - d_q| / reach where |d_p - d_q| < reach, else 0 (the depth factor),
+//   D = D_pq = 2 pi sigma_p^2 sigma_q^2 / S exp(-r^2 / 2S)   (Sec. 3.2, the 2D form of eq. 8).
+struct PairLoop {
+  struct Pair {
+    double depth_diff;  // d_p - d_q
+    bool in_reach;      // |d_p - d_q| < reach
+    double delta;       // Delta, 0 out of reach
+    double du;          // u_p - u_q
+    double dv;          // v_p - v_q
+    double r2;          // r^2
+    double inv_s;       // 1 / S
+    double d;           // D_pq
+  };
+
+  PairLoop(const ProjectedGaussian& p, const ImageMixtureSlice& q)
+      : q_u(q.u), q_v(q.v), q_sigma2(q.sigma2), q_depth(q.depth_mm), n(q.size), u(p.u), v(p.v),
+        sigma2(p.sigma2), depth(p.depth_mm), reach(p.reach_mm), inv_reach(1.0 / p.reach_mm) {}
+
+  Pair at(std::size_t k) const {
+    Pair pair;
+    pair.depth_diff = depth - q_depth[k];
+    const double abs_diff = std::abs(pair.depth_diff);
+    pair.in_reach = abs_diff < reach;
+    pair.delta = pair.in_reach ? 1.0 - abs_diff * inv_reach : 0.0;
+    pair.du = u - q_u[k];
+    pair.dv = v - q_v[k];
+    pair.r2 = pair.du * pair.du + pair.dv * pair.dv;
+    pair.inv_s = 1.0 / (sigma2 + q_sigma2[k]);
+    pair.d = kTwoPi * sigma2 * q_sigma2[k] * pair.inv_s * detail::exp_nonpositive(-0.5 * pair.r2 * pair.inv_s);
+    return pair;
+  }
+
+  const double* const q_u;
+  const double* const q_v;
+  const double* const q_sigma2;
+  const double* const q_depth;
+  const std::size_t n;
+  const double u;
+  const double v;
+  const double sigma2;
+  const double depth;
+  const double reach;
+  const double inv_reach;
+};
+
+// Both loops are branch-free so that gcc vectorises them: 2 doubles per SSE2 register on any
+// x86-64, 4 with fused multiply-adds in the x86-64-v3 (AVX2, FMA) clone, which the loader picks on
+// CPUs that have it. `open`: 1 or 0 per Gaussian of the slice.
 HANDTRACK_TARGET_CLONES PairSums pair_sums(const ProjectedGaussian& p, const ImageMixtureSlice& q,
                                            const double* open) {
-  // Everything the loop reads in locals: gcc then sees unit-stride loads, not gathers.
-  const double* const q_u = q.u;
-  const double* const q_v = q.v;
-  const double* const q_sigma2 = q.sigma2;
-  const double* const q_depth = q.depth_mm;
-  const double* const q_open = open;
-  const std::size_t n = q.size;
-  const double u = p.u;
-  const double v = p.v;
-  const double sigma2 = p.sigma2;
-  const double depth = p.depth_mm;
-  const double reach = p.reach_mm;
-  const double inv_reach = 1.0 / reach;
+  const PairLoop loop(p, q);
   double overlap = 0.0;
   double weight = 0.0;
   double weight_du = 0.0;
@@ -68,48 +104,28 @@ HANDTRACK_TARGET_CLONES PairSums pair_sums(const ProjectedGaussian& p, const Ima
   double weight_r2 = 0.0;
   double depth_sign = 0.0;
 #pragma omp simd reduction(+ : overlap, weight, weight_du, weight_dv, weight_r2, depth_sign)
-  for (std::size_t k = 0; k < n; ++k) {
-    const double depth_diff = depth - q_depth[k];
-    const double abs_diff = std::abs(depth_diff);
-    const double in_reach = abs_diff < reach ? q_open[k] : 0.0;
-    const double delta = in_reach * (1.0 - abs_diff * inv_reach);
-    const double du = u - q_u[k];
-    const double dv = v - q_v[k];
-    const double r2 = du * du + dv * dv;
-    const double inv_s = 1.0 / (sigma2 + q_sigma2[k]);
-    const double d = kTwoPi * sigma2 * q_sigma2[k] * inv_s * detail::exp_nonpositive(-0.5 * r2 * inv_s);
-    const double w = delta * d * inv_s;
-    overlap += delta * d;
+  for (std::size_t k = 0; k < loop.n; ++k) {
+    const PairLoop::Pair pair = loop.at(k);
+    const double counted = pair.in_reach ? open[k] : 0.0;
+    const double delta_d = counted * pair.delta * pair.d;
+    const double w = delta_d * pair.inv_s;
+    overlap += delta_d;
     weight += w;
-    weight_du += w * du;
-    weight_dv += w * dv;
-    weight_r2 += w * r2 * inv_s;
-    depth_sign += depth_diff > 0.0 ? in_reach * d : -in_reach * d;
+    weight_du += w * pair.du;
+    weight_dv += w * pair.dv;
+    weight_r2 += w * pair.r2 * pair.inv_s;
+    depth_sign += pair.depth_diff > 0.0 ? counted * pair.d : -counted * pair.d;
   }
   return {overlap, weight, weight_du, weight_dv, weight_r2, depth_sign};
 }
 
 // covered[k] += Delta D_pq for each Gaussian q = k of the slice: the first pass of a capped E_sim.
 HANDTRACK_TARGET_CLONES void add_overlaps(const ProjectedGaussian& p, const ImageMixtureSlice& q, double* covered) {
-  const double* const q_u = q.u;
-  const double* const q_v = q.v;
-  const double* const q_sigma2 = q.sigma2;
-  const double* const q_depth = q.depth_mm;
-  const std::size_t n = q.size;
-  const double u = p.u;
-  const double v = p.v;
-  const double sigma2 = p.sigma2;
-  const double depth = p.depth_mm;
-  const double reach = p.reach_mm;
-  const double inv_reach = 1.0 / reach;
+  const PairLoop loop(p, q);
 #pragma omp simd
-  for (std::size_t k = 0; k < n; ++k) {
-    const double abs_diff = std::abs(depth - q_depth[k]);
-    const double delta = abs_diff < reach ? 1.0 - abs_diff * inv_reach : 0.0;
-    const double du = u - q_u[k];
-    const double dv = v - q_v[k];
-    const double inv_s = 1.0 / (sigma2 + q_sigma2[k]);
-    covered[k] += delta * kTwoPi * sigma2 * q_sigma2[k] * inv_s * detail::exp_nonpositive(-0.5 * (du * du + dv * dv) * inv_s);
+  for (std::size_t k = 0; k < loop.n; ++k) {
+    const PairLoop::Pair pair = loop.at(k);
+    covered[k] += pair.delta * pair.d;
   }
 }
 
