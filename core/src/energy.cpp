@@ -487,8 +487,8 @@ PoseEnergy::PoseEnergy(SimilarityFactor factor, const EnergyWeights& weights, do
     : factor_(factor),
       weights_(weights),
       similarity_(factor == SimilarityFactor::kDepthAndLabel ? SimilarityFactor::kDepth : factor, weights.label_radius_mm,
-                  factor == SimilarityFactor::kLabel ? 0.0 : weights.coverage_cap),
-      label_similarity_(SimilarityFactor::kLabel, weights.label_radius_mm),
+                  weights.coverage_cap),
+      label_similarity_(SimilarityFactor::kLabel, weights.label_radius_mm, weights.coverage_cap),
       label_share_(label_share),
       smoothness_(weights.smoothness_translation_per_mm) {}
 

@@ -65,8 +65,8 @@ StartSearch::StartSearch(const TrackerConfig& config)
     : init_iterations_(config.init_iterations),
       late_fusion_(config.mode == EnergyMode::kLateFusion),
       model_(HandModel::default_adult(config.scale)),
-      energy_(SimilarityFactor::kDepth, mode_weights(config)),
-      guided_energy_(SimilarityFactor::kDepthAndLabel, mode_weights(config)),
+      energy_(SimilarityFactor::kDepth, search_weights(config)),
+      guided_energy_(SimilarityFactor::kDepthAndLabel, search_weights(config)),
       optimizer_(config.optimizer),
       scratch_(model_, PoseParams::Zero()),
       scale_(config.scale) {

@@ -352,6 +352,16 @@ EnergyWeights mode_weights(const TrackerConfig& config) {
   return weights;
 }
 
+// Measured, not explained: with E_sim's coverage cap in the (re)start search, the SR305 frames'
+// right-hand fits got worse (230536/90: confidence 0.98 -> 0.60) and 3-7 of 17 turned into left
+// hands; a hypothesis starts far from the hand, where the cap's closed image Gaussians may leave
+// the fit less to climb on (docs/TRACKER.md, "E_sim's coverage cap").
+EnergyWeights search_weights(const TrackerConfig& config) {
+  EnergyWeights weights = mode_weights(config);
+  weights.coverage_cap = 0.0;
+  return weights;
+}
+
 DepthInputConfig input_config(const TrackerConfig& config) {
   DepthInputConfig input = config.input;
   input.free_space.enabled = mode_weights(config).free_space != 0.0;
@@ -362,6 +372,8 @@ PoseTracker::PoseTracker(TrackerConfig config)
     : config_(config),
       search_(config),
       common_energy_(SimilarityFactor::kDepthAndLabel, mode_weights(config), config.fusion_label_weight),
+      depth_energy_(SimilarityFactor::kDepth, mode_weights(config)),
+      guided_energy_(SimilarityFactor::kDepthAndLabel, mode_weights(config)),
       optimizer_(config.optimizer),
       background_(config.background_checks ? std::make_unique<BackgroundSearch>(config) : nullptr),
       rng_(config.seed) {}
@@ -438,7 +450,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
       PoseParams particle = *previous_;
       for (int j = 0; j < kNumPoseParams; ++j) particle[j] += alpha(rng_) * velocity[j];
       const bool guided = fuse && i == config_.particles - 1;
-      auto r = optimizer_.maximise(guided ? search_.guided_energy() : search_.depth_energy(), frame, particle, scratch_);
+      auto r = optimizer_.maximise(guided ? guided_energy_ : depth_energy_, frame, particle, scratch_);
       iterations_ += config_.optimizer.iterations;
       // Late fusion (Sec. 5): "the pose particle which converges with the best energy value is
       // chosen". The particles optimise different energies, so each is judged by one common energy.

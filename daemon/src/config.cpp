@@ -229,7 +229,7 @@ const std::vector<Field>& fields() {
     {"tracker.energy.w_f", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.free_space; }}, 0, 1000,
      "w_f, weight of the free-space term E_free: model parts over the background (ours, late fusion only; 0 = the paper's energy)", true},
     {"tracker.energy.coverage_cap", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.coverage_cap; }}, 0, 100,
-     "c, E_sim's coverage cap: an image Gaussian earns at most c times its own overlap, however many model parts cover it (ours, late fusion only; 0 = the paper's E_sim; 2: better from behind the hand, docs/TRACKER.md)", true},
+     "c, E_sim's coverage cap: an image Gaussian earns at most c times its own overlap, however many model parts cover it (ours, late fusion's tracking only, not its (re)starts; 0 = the paper's E_sim; docs/TRACKER.md)", true},
     {"tracker.energy.label_radius_mm", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.label_radius_mm; }}, 1, 5000,
      "R_i, radius of influence of the label similarity factor (Sec. 4.3: 200 mm)", true},
     {"tracker.energy.smoothness_translation_per_mm", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.smoothness_translation_per_mm; }}, 0, 1,

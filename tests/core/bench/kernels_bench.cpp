@@ -115,7 +115,7 @@ void BM_Similarity(benchmark::State& state) {
     i = (i + 1) % posed_cases().size();
   }
 }
-BENCHMARK(BM_Similarity)->ArgNames({"label", "capped"})->Args({0, 0})->Args({1, 0})->Args({0, 1});
+BENCHMARK(BM_Similarity)->ArgNames({"label", "capped"})->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1});
 
 // The same with the plain reference (every pair, libm exp, the chain one point at a time).
 void BM_SimilarityReference(benchmark::State& state) {

@@ -217,7 +217,7 @@ int main(int argc, char** argv) {
   app.add_option("--w-lim", config.weights.limits, "w_l, weight of E_lim (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
   app.add_option("--w-smo", config.weights.smoothness, "w_s, weight of E_smo (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
   app.add_option("--coverage-cap", config.weights.coverage_cap,
-                 "late fusion: c, E_sim's coverage cap (default 0: the paper's E_sim; 2 measured best; docs/TRACKER.md, \"E_sim's coverage cap\")")
+                 "late fusion: c, E_sim's coverage cap while tracking (default 2, measured best; 0: the paper's E_sim; docs/TRACKER.md, \"E_sim's coverage cap\")")
       ->check(CLI::Range(0.0, 100.0));
   app.add_option("--fusion-label-weight", config.fusion_label_weight,
                  "late fusion: label share lambda of the common energy that picks the particle")

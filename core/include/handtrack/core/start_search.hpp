@@ -71,9 +71,6 @@ class StartSearch {
   // searches that use it.
   void set_other_hand(const HandObstacle* other) { other_hand_ = other; }
   [[nodiscard]] const HandModel& model() const { return model_; }
-  // The energies a search optimises: depth-only (Sec. 4.1), detection-guided (Sec. 4.3).
-  [[nodiscard]] const PoseEnergy& depth_energy() const { return energy_; }
-  [[nodiscard]] const PoseEnergy& guided_energy() const { return guided_energy_; }
 
   // The whole search on one frame: every hypothesis screened, the best refined; the best fit.
   // `stop` (may be null) set: it returns at the next hypothesis with a fit to be dropped.
@@ -111,6 +108,8 @@ class StartSearch {
   int init_iterations_;
   bool late_fusion_;
   HandModel model_;
+  // The energies a search optimises (search_weights): depth-only (Sec. 4.1), detection-guided
+  // (Sec. 4.3).
   PoseEnergy energy_;
   PoseEnergy guided_energy_;
   AdaptiveGradientAscent optimizer_;

@@ -153,8 +153,11 @@ struct TrackerConfig {
 // an energy reads it (late fusion with w_f > 0: PoseTracker). Every TrackerInputs and HandsInputs
 // made for a tracker is made with this.
 DepthInputConfig input_config(const TrackerConfig& config);
-// The weights of `config`'s energies: E_free (w_f) only with late fusion.
+// The weights of `config`'s energies: E_free (w_f) and E_sim's coverage cap only with late fusion.
 EnergyWeights mode_weights(const TrackerConfig& config);
+// The weights of the (re)start search and its checks (StartSearch): mode_weights() with E_sim as
+// eq. 6, without the coverage cap.
+EnergyWeights search_weights(const TrackerConfig& config);
 
 // N points at the origin (Eigen leaves a default-constructed vector uninitialised).
 template <size_t N>
@@ -262,6 +265,10 @@ class PoseTracker {
   StartSearch search_;  // the (re)starts, the checks on this thread, and explain()
   // Late fusion: the particles' common energy at `params` (see EnergyMode).
   PoseEnergy common_energy_;     // late fusion: compares the particles (label share fusion_label_weight)
+  // The particles' energies (mode_weights, the coverage cap included): depth-only, and with late
+  // fusion detection-guided for the last particle.
+  PoseEnergy depth_energy_;
+  PoseEnergy guided_energy_;
   AdaptiveGradientAscent optimizer_;
   PosedHand scratch_;
   std::unique_ptr<BackgroundSearch> background_;  // TrackerConfig::background_checks
