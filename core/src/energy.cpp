@@ -47,35 +47,67 @@ struct PairSums {
 // members that the compiler keeps in registers: it then sees unit-stride loads, not gathers. at(k)
 // is one pair q = k, branch-free:
 //   Delta = 1 - |d_p - d_q| / reach where |d_p - d_q| < reach, else 0 (the depth factor),
-//   D = D_pq = 2 pi sigma_p^2 sigma_q^2 / S exp(-r^2 / 2S)   (Sec. 3.2, the 2D form of eq. 8).
+//   D = D_pq = 2 pi sigma_p^2 sigma_q^2 / S exp(-r^2 / 2S)   (Sec. 3.2, the 2D form of eq. 8);
+// place(k) its image-plane geometry alone.
 struct PairLoop {
-  struct Pair {
-    double depth_diff;  // d_p - d_q
-    bool in_reach;      // |d_p - d_q| < reach
-    double delta;       // Delta, 0 out of reach
-    double du;          // u_p - u_q
-    double dv;          // v_p - v_q
-    double r2;          // r^2
-    double inv_s;       // 1 / S
-    double d;           // D_pq
+  struct Place {
+    double du;     // u_p - u_q
+    double dv;     // v_p - v_q
+    double r2;     // r^2
+    double inv_s;  // 1 / S
+  };
+  struct Pair : Place {
+    double delta_d;   // Delta D_pq (0 out of reach)
+    double signed_d;  // D_pq sign(d_p - d_q) where |d_p - d_q| < reach, else 0
   };
 
   PairLoop(const ProjectedGaussian& p, const ImageMixtureSlice& q)
       : q_u(q.u), q_v(q.v), q_sigma2(q.sigma2), q_depth(q.depth_mm), n(q.size), u(p.u), v(p.v),
         sigma2(p.sigma2), depth(p.depth_mm), reach(p.reach_mm), inv_reach(1.0 / p.reach_mm) {}
 
-  Pair at(std::size_t k) const {
-    Pair pair;
-    pair.depth_diff = depth - q_depth[k];
-    const double abs_diff = std::abs(pair.depth_diff);
-    pair.in_reach = abs_diff < reach;
-    pair.delta = pair.in_reach ? 1.0 - abs_diff * inv_reach : 0.0;
-    pair.du = u - q_u[k];
-    pair.dv = v - q_v[k];
-    pair.r2 = pair.du * pair.du + pair.dv * pair.dv;
-    pair.inv_s = 1.0 / (sigma2 + q_sigma2[k]);
-    pair.d = kTwoPi * sigma2 * q_sigma2[k] * pair.inv_s * detail::exp_nonpositive(-0.5 * pair.r2 * pair.inv_s);
+  [[gnu::always_inline]] Place place(std::size_t k) const {
+    Place place;
+    place.du = u - q_u[k];
+    place.dv = v - q_v[k];
+    place.r2 = place.du * place.du + place.dv * place.dv;
+    place.inv_s = 1.0 / (sigma2 + q_sigma2[k]);
+    return place;
+  }
+
+  [[gnu::always_inline]] Pair at(std::size_t k) const {
+    Pair pair{place(k), 0.0, 0.0};
+    const double depth_diff = depth - q_depth[k];
+    const double abs_diff = std::abs(depth_diff);
+    const bool in_reach = abs_diff < reach;
+    const double d =
+        kTwoPi * sigma2 * q_sigma2[k] * pair.inv_s * detail::exp_nonpositive(-0.5 * pair.r2 * pair.inv_s);
+    pair.delta_d = in_reach ? (1.0 - abs_diff * inv_reach) * d : 0.0;
+    pair.signed_d = in_reach ? (depth_diff > 0.0 ? d : -d) : 0.0;
     return pair;
+  }
+
+  // PairSums over the slice's pairs, pair k as pair(k) (a Pair: its Place, Delta D_pq and signed
+  // D_pq). Inline, so that each kernel below vectorises its own loop.
+  template <class PairAt>
+  [[gnu::always_inline]] PairSums sum(const PairAt& pair_at) const {
+    double overlap = 0.0;
+    double weight = 0.0;
+    double weight_du = 0.0;
+    double weight_dv = 0.0;
+    double weight_r2 = 0.0;
+    double depth_sign = 0.0;
+#pragma omp simd reduction(+ : overlap, weight, weight_du, weight_dv, weight_r2, depth_sign)
+    for (std::size_t k = 0; k < n; ++k) {
+      const Pair pair = pair_at(k);
+      const double w = pair.delta_d * pair.inv_s;
+      overlap += pair.delta_d;
+      weight += w;
+      weight_du += w * pair.du;
+      weight_dv += w * pair.dv;
+      weight_r2 += w * pair.r2 * pair.inv_s;
+      depth_sign += pair.signed_d;
+    }
+    return {overlap, weight, weight_du, weight_dv, weight_r2, depth_sign};
   }
 
   const double* const q_u;
@@ -91,42 +123,49 @@ struct PairLoop {
   const double inv_reach;
 };
 
-// Both loops are branch-free so that gcc vectorises them: 2 doubles per SSE2 register on any
+// The loops are branch-free so that gcc vectorises them: 2 doubles per SSE2 register on any
 // x86-64, 4 with fused multiply-adds in the x86-64-v3 (AVX2, FMA) clone, which the loader picks on
-// CPUs that have it. `open`: 1 or 0 per Gaussian of the slice.
-HANDTRACK_TARGET_CLONES PairSums pair_sums(const ProjectedGaussian& p, const ImageMixtureSlice& q,
-                                           const double* open) {
+// CPUs that have it.
+
+// Eq. 6: every pair of the slice counts.
+HANDTRACK_TARGET_CLONES PairSums pair_sums(const ProjectedGaussian& p, const ImageMixtureSlice& q) {
   const PairLoop loop(p, q);
-  double overlap = 0.0;
-  double weight = 0.0;
-  double weight_du = 0.0;
-  double weight_dv = 0.0;
-  double weight_r2 = 0.0;
-  double depth_sign = 0.0;
-#pragma omp simd reduction(+ : overlap, weight, weight_du, weight_dv, weight_r2, depth_sign)
-  for (std::size_t k = 0; k < loop.n; ++k) {
-    const PairLoop::Pair pair = loop.at(k);
-    const double counted = pair.in_reach ? open[k] : 0.0;
-    const double delta_d = counted * pair.delta * pair.d;
-    const double w = delta_d * pair.inv_s;
-    overlap += delta_d;
-    weight += w;
-    weight_du += w * pair.du;
-    weight_dv += w * pair.dv;
-    weight_r2 += w * pair.r2 * pair.inv_s;
-    depth_sign += pair.depth_diff > 0.0 ? counted * pair.d : -counted * pair.d;
-  }
-  return {overlap, weight, weight_du, weight_dv, weight_r2, depth_sign};
+  return loop.sum([&](std::size_t k) { return loop.at(k); });
 }
 
-// covered[k] += Delta D_pq for each Gaussian q = k of the slice: the first pass of a capped E_sim.
+// The first pass of a capped E_sim: covered[k] += Delta D_pq for each Gaussian q = k of the slice;
+// add_and_keep_overlaps also keeps each pair's Delta D_pq and signed D_pq in `kept` (2 x the
+// slice's size: all the one, then all the other) for the second pass.
+static_assert(kMaxModelGaussians <= ImageMixture::kMaxPairedModelGaussians, "pair_scratch() has room for every pair");
 HANDTRACK_TARGET_CLONES void add_overlaps(const ProjectedGaussian& p, const ImageMixtureSlice& q, double* covered) {
   const PairLoop loop(p, q);
 #pragma omp simd
+  for (std::size_t k = 0; k < loop.n; ++k) covered[k] += loop.at(k).delta_d;
+}
+HANDTRACK_TARGET_CLONES void add_and_keep_overlaps(const ProjectedGaussian& p, const ImageMixtureSlice& q,
+                                                   double* covered, double* kept) {
+  const PairLoop loop(p, q);
+  double* const delta_d = kept;
+  double* const signed_d = kept + loop.n;
+#pragma omp simd
   for (std::size_t k = 0; k < loop.n; ++k) {
     const PairLoop::Pair pair = loop.at(k);
-    covered[k] += pair.delta * pair.d;
+    covered[k] += pair.delta_d;
+    delta_d[k] = pair.delta_d;
+    signed_d[k] = pair.signed_d;
   }
+}
+
+// The second pass: the pairs kept by the first (no exp again) whose q is open (`open`: 1 or 0 per
+// Gaussian of the slice).
+HANDTRACK_TARGET_CLONES PairSums open_pair_sums(const ProjectedGaussian& p, const ImageMixtureSlice& q,
+                                                const double* open, const double* kept) {
+  const PairLoop loop(p, q);
+  const double* const delta_d = kept;
+  const double* const signed_d = kept + loop.n;
+  return loop.sum([&](std::size_t k) {
+    return PairLoop::Pair{loop.place(k), open[k] * delta_d[k], open[k] * signed_d[k]};
+  });
 }
 
 // The 3D overlap of eq. 8 for one pair of isotropic Gaussians, E_col's and E_hand's, from the
@@ -240,10 +279,15 @@ double SimilarityTerm::evaluate_centres(const HandModel& model, const PosedHand&
   const auto& gaussians = model.gaussians();
   const bool capped = coverage_cap_ > 0.0;
   const bool by_label = factor_ == SimilarityFactor::kLabel;
-  // S_q (with a cap), and 1 where q is open (below its cap: its pairs count), 0 where not.
+  // With a cap: S_q, and 1 where q is open (below its cap: its pairs count), 0 where not; with the
+  // gradient too, each pair's values from the first pass, 2 x its slice's size from kept_at[i].
   const std::size_t n = input.mixture.size();
   const ImageMixture::Coverage coverage = input.mixture.coverage_scratch();
-  std::fill_n(coverage.open, n, 1.0);
+  const bool keep = capped && dE_dcentres != nullptr;
+  double* const kept =
+      keep ? input.mixture.pair_scratch(2 * n * static_cast<std::size_t>(hand.gaussian_count())) : nullptr;
+  std::array<std::size_t, kMaxModelGaussians> kept_at{};
+  std::size_t kept_size = 0;
   if (capped) std::fill_n(coverage.covered, n, 0.0);
   // Each model Gaussian projected: u = fx x/z + cx, v = fy y/z + cy, sigma_p = sigma_h f/z,
   // d_p = z - sigma_h; with a cap, its overlaps added to the coverage S_q.
@@ -266,7 +310,14 @@ double SimilarityTerm::evaluate_centres(const HandModel& model, const PosedHand&
     const double hi = p.depth_mm + p.reach_mm + kSliceMarginMm;
     ImageMixtureSlice& slice = slices[static_cast<size_t>(i)];
     slice = by_label ? input.mixture.label_slice(g.label, lo, hi) : input.mixture.depth_slice(lo, hi);
-    if (capped && slice.size > 0) add_overlaps(p, slice, coverage.covered + slice.first);
+    if (slice.size == 0 || !capped) continue;
+    if (keep) {
+      kept_at[static_cast<size_t>(i)] = kept_size;
+      add_and_keep_overlaps(p, slice, coverage.covered + slice.first, kept + kept_size);
+      kept_size += 2 * slice.size;
+    } else {
+      add_overlaps(p, slice, coverage.covered + slice.first);
+    }
   }
   double energy = 0.0;
   if (capped) {
@@ -284,7 +335,9 @@ double SimilarityTerm::evaluate_centres(const HandModel& model, const PosedHand&
     const ImageMixtureSlice& slice = slices[static_cast<size_t>(i)];
     if (slice.size == 0) continue;
     const ProjectedGaussian& p = projected[static_cast<size_t>(i)];
-    const PairSums sums = pair_sums(p, slice, coverage.open + slice.first);
+    const PairSums sums =
+        capped ? open_pair_sums(p, slice, coverage.open + slice.first, kept + kept_at[static_cast<size_t>(i)])
+               : pair_sums(p, slice);
     if (!capped) energy += sums.overlap;
     if (dE_dcentres == nullptr) continue;
     const Vector3d& mu = hand.centre(i);

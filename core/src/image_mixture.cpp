@@ -62,6 +62,7 @@ void ImageMixture::reserve(std::size_t n) {
   order_.reserve(n);
   covered_.reserve(n);
   open_.reserve(n);
+  pairs_.values.reserve(2 * kMaxPairedModelGaussians * n);
   label_begin_.reserve(kNumPartLabels + 2);  // assign(): labels 0..kNumPartLabels
 }
 
@@ -92,6 +93,11 @@ void ImageMixture::assign(const std::vector<ImageGaussian>& gaussians) {
     ++label_begin_[static_cast<std::size_t>(g.label) + 1];
   }
   std::partial_sum(label_begin_.begin(), label_begin_.end(), label_begin_.begin());
+}
+
+double* ImageMixture::pair_scratch(std::size_t values) const {
+  if (pairs_.values.size() < values) pairs_.values.resize(values);
+  return pairs_.values.data();
 }
 
 ImageMixtureSlice ImageMixture::depth_slice(double lo_mm, double hi_mm) const {

@@ -177,7 +177,9 @@ TEST(RealStillHand, StaysTheRightHandWhileTracked) {
     if (out.state == TrackingState::kNoHand) continue;  // beyond the working volume
     ++frames;
     still_right += out.handedness == Handedness::kRight ? 1 : 0;
-    if (out.handedness != Handedness::kRight) std::cout << "turned to a left hand while tracked: " << sr305_name(file) << "\n";
+    if (out.handedness != Handedness::kRight) {
+      std::cout << "turned to a left hand while tracked: " << sr305_name(file) << "\n";
+    }
   }
   EXPECT_GE(frames, 6) << "frames with a hand in the working volume";
   EXPECT_GE(12 * still_right, 11 * frames) << still_right << " of " << frames << " still frames stayed a right hand";

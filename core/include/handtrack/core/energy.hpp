@@ -79,6 +79,8 @@ enum class SimilarityFactor {
 // The pair sums read DepthInput::mixture (C_I as structure-of-arrays, built once per frame): per
 // model Gaussian only the slice of image Gaussians within the depth factor's reach (and, for the
 // label factor, of its label), summed branch-free in SIMD with an exp that needs no libm call.
+// With a cap, two passes: the first sums S_q and keeps each pair's Delta D_pq and signed D_pq
+// (ImageMixture::pair_scratch), the second sums the gradient from them over the open q.
 class SimilarityTerm {
  public:
   // coverage_cap: c above (0: eq. 6).

@@ -52,6 +52,12 @@ class ImageMixture {
     double* open = nullptr;
   };
   [[nodiscard]] Coverage coverage_scratch() const { return {covered_.data(), open_.data()}; }
+  // Scratch of `values` doubles for what a capped E_sim's first pass keeps of each pair for its
+  // second (SimilarityTerm). reserve(n) makes room for two values per pair of n image Gaussians
+  // with up to kMaxPairedModelGaussians model Gaussians; more grows it (allocates). Its contents
+  // are not copied with the mixture.
+  [[nodiscard]] double* pair_scratch(std::size_t values) const;
+  static constexpr std::size_t kMaxPairedModelGaussians = 64;  // kMaxModelGaussians (kinematics.hpp)
 
  private:
   struct Columns {
@@ -68,6 +74,17 @@ class ImageMixture {
   std::vector<std::size_t> order_;        // scratch for sorting
   mutable std::vector<double> covered_;   // coverage_scratch()
   mutable std::vector<double> open_;
+  // pair_scratch(): a copy of the mixture gets none of it (nor its room: reserve() the copy).
+  struct Scratch {
+    std::vector<double> values;
+    Scratch() = default;
+    Scratch(const Scratch& /*other*/) {}
+    Scratch& operator=(const Scratch& /*other*/) { return *this; }
+    Scratch(Scratch&&) noexcept = default;
+    Scratch& operator=(Scratch&&) noexcept = default;
+    ~Scratch() = default;
+  };
+  mutable Scratch pairs_;
 };
 
 }  // namespace handtrack
