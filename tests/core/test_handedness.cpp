@@ -66,12 +66,12 @@ INSTANTIATE_TEST_SUITE_P(
 
 // The SR305's frames of both recordings, fitted from scratch with the working volume these
 // recordings need (docs/TRACKER.md, "Real frames"), depth-only and in the shipped configuration
-// (late fusion with the shipped forest). Measured on the 17 frames with a hand in the volume:
-// depth-only all but 230536/170 and 231615/160 fit as a right hand; with late fusion all but
-// 230536/30, 90, 130 and 150 (the forest, trained on renders, mislabels real depth; the forest
-// before the held balls: all but 230536/130, 150 and 231615/0, 40; the goal is every
-// frame). The bound: 3 of 4 depth-only, 2 of 3 with late fusion. (230536 alone, as this test read
-// before: late fusion 4 of 8 now, 6 of 8 with the forest before.)
+// (late fusion with the shipped forest). Measured on the 17 frames with a hand in the volume
+// (2026-11-27): depth-only all but 231615/160 fit as a right hand, with late fusion all 17; most of
+// them by the tie rule (the evidence within the tie: docs/TRACKER.md, "E_sim's coverage cap"), so a
+// change to the model or the energy turns one or two easily (an earlier version: with late fusion
+// all but 230536/30, 90, 130 and 150). The bound: 3 of 4 depth-only, 2 of 3 with late fusion; the
+// issue's goal is every frame.
 struct RealCase {
   EnergyMode mode;
   int min_right_hands_of_12;  // of every 12 frames with a hand, at least this many right hands
