@@ -207,6 +207,11 @@ double fit_and_score(const std::vector<CalibrationFrame>& frames, const TrackerC
 
 }  // namespace
 
+TrackerConfig calibration_tracker_config(TrackerConfig config) {
+  config.weights.smoothness = kPapersSmoothness;
+  return config;
+}
+
 CalibrationResult calibrate_hand_scale(const std::vector<CalibrationFrame>& frames, const TrackerConfig& tracker,
                                        const CalibrationConfig& config) {
   check_grid(frames, config);

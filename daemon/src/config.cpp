@@ -223,7 +223,7 @@ const std::vector<Field>& fields() {
     {"tracker.energy.w_l", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.limits; }}, 0, 1000,
      "w_l, weight of the joint-limit term E_lim (Sec. 4.1: 0.2)", true},
     {"tracker.energy.w_s", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.smoothness; }}, 0, 1000,
-     "w_s, weight of the smoothness term E_smo (Sec. 4.1: 1.0)", true},
+     "w_s, weight of the smoothness term E_smo (Sec. 4.1: 1.0; ours: 0.1, measured best, docs/TRACKER.md)", true},
     {"tracker.energy.w_h", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.inter_hand; }}, 0, 1000,
      "w_h, weight of the collision term between two hands E_hand (ours: the paper tracks one hand)", true},
     {"tracker.energy.w_f", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.free_space; }}, 0, 1000,

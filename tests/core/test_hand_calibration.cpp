@@ -40,7 +40,7 @@ struct Recovery {
 };
 
 Recovery calibrate_subject(synth::SyntheticCamera& camera) {
-  Tracker tracker;
+  Tracker tracker(calibration_tracker_config());
   CalibrationSet set;
   synth::SynthFrame frame;
   for (int i = 0; i < kCalibrationFrames && !set.full(); ++i) {

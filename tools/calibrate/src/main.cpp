@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
 
   try {
     const SequenceReader reader(sequence);
-    const TrackerConfig config;
+    const TrackerConfig config = calibration_tracker_config();
     Tracker tracker(config);
     CalibrationSet set(keep, config.input);
     for (size_t i = 0; i < reader.frame_count() && !set.full(); ++i) {
