@@ -191,9 +191,9 @@ TEST(RealStillHand, StaysTheRightHandWhileTracked) {
 // the second half of the sequence. Without those trials it never does, which this test also checks,
 // so that it keeps exercising them. Measured: all of frames 150-299 with them, none
 // without (docs/TRACKER.md, "A mediocre fit is tried as the other hand again"). With the paper's
-// w_s: since w_s = 0.1 became the default, the first trial chooses the right hand on this scene, and on all
-// 30 fingercount scenes of seeds 1-3 (five views, both hands) as well (docs/TRACKER.md, "w_s, the
-// weight of E_smo").
+// w_s: since w_s = 0.1 became the default, the first trial chooses the right hand on this scene,
+// and on all 30 fingercount scenes of seeds 1-3 (five views, both hands) as well (docs/TRACKER.md,
+// "w_s, the weight of E_smo").
 TEST(HandednessRetrial, AHandChosenWrongOnAFistIsTriedAgain) {
   const PartForest forest = PartForest::load(shipped_forest_path().value());
   synth::SynthOptions options;
