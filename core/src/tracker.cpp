@@ -342,12 +342,15 @@ TrackerOutput Tracker::track(const DepthImage& depth, const PixelLabeller* label
 
 // Depth-only tracking runs the paper's eq. 2: with E_free it lost the fists of fingercount and the
 // fast half of random (the palm-view Dexter motions, 7 subjects: 13.2 -> 17.2 mm; docs/TRACKER.md
-// "Free space"), and E_sim is eq. 6's, without the coverage cap.
+// "Free space"), and E_sim is eq. 6's, without the coverage cap; its w_c is the paper's too
+// (EnergyWeights::tracking_collision is late fusion's).
 EnergyWeights mode_weights(const TrackerConfig& config) {
   EnergyWeights weights = config.weights;
   if (config.mode == EnergyMode::kDepthOnly) {
     weights.free_space = 0.0;
     weights.coverage_cap = 0.0;
+  } else {
+    weights.collision = config.weights.tracking_collision;
   }
   return weights;
 }
@@ -355,10 +358,12 @@ EnergyWeights mode_weights(const TrackerConfig& config) {
 // Measured, not explained: with E_sim's coverage cap in the (re)start search, the SR305 frames'
 // right-hand fits got worse (230536/90: confidence 0.98 -> 0.60) and 3-7 of 17 turned into left
 // hands; a hypothesis starts far from the hand, where the cap's closed image Gaussians may leave
-// the fit less to climb on (docs/TRACKER.md, "E_sim's coverage cap").
+// the fit less to climb on (docs/TRACKER.md, "E_sim's coverage cap"). The same for w_c below the
+// paper's (EnergyWeights::tracking_collision): 4 of the 17 frames fitted as left hands.
 EnergyWeights search_weights(const TrackerConfig& config) {
   EnergyWeights weights = mode_weights(config);
   weights.coverage_cap = 0.0;
+  weights.collision = config.weights.collision;
   return weights;
 }
 

@@ -219,7 +219,9 @@ const std::vector<Field>& fields() {
      "only connected background regions at least this large leave the hand (mm^2)", true},
     // [tracker.energy] (Sec. 4.1, Sec. 4.3)
     {"tracker.energy.w_c", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.collision; }}, 0, 1000,
-     "w_c, weight of the collision term E_col (Sec. 4.1: 1.0)", true},
+     "w_c, weight of the collision term E_col (Sec. 4.1: 1.0) in the (re)start search and its checks and in depth-only tracking", true},
+    {"tracker.energy.w_c_tracking", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.tracking_collision; }}, 0, 1000,
+     "w_c while late fusion tracks (ours, not its (re)starts: 0.5, measured best; docs/TRACKER.md)", true},
     {"tracker.energy.w_l", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.limits; }}, 0, 1000,
      "w_l, weight of the joint-limit term E_lim (Sec. 4.1: 0.2)", true},
     {"tracker.energy.w_s", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.smoothness; }}, 0, 1000,

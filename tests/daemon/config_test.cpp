@@ -26,6 +26,7 @@ TEST(DaemonConfig, DefaultsAreThePapersValuesOrOursMeasured) {
   EXPECT_EQ(c.tracker.particles, 2);                     // Sec. 7
   EXPECT_EQ(c.tracker.optimizer.iterations, 10);         // Sec. 7
   EXPECT_DOUBLE_EQ(c.tracker.weights.collision, 1.0);    // w_c, Sec. 4.1
+  EXPECT_DOUBLE_EQ(c.tracker.weights.tracking_collision, kMeasuredTrackingCollision);  // ours, measured
   EXPECT_DOUBLE_EQ(c.tracker.weights.limits, 0.2);       // w_l
   EXPECT_DOUBLE_EQ(c.tracker.weights.smoothness, kMeasuredSmoothness);  // w_s: ours, measured
   EXPECT_DOUBLE_EQ(c.tracker.weights.label_radius_mm, 200.0);  // R_i, Sec. 4.3
@@ -50,13 +51,14 @@ TEST(DaemonConfig, ShippedFileEqualsTheDefaults) {
 TEST(DaemonConfig, ValuesOverrideDefaults) {
   const auto c = parse_config(
       "[daemon]\nsource = \"synthetic:pinch\"\nlog_level = \"debug\"\n"
-      "[tracker]\nparticles = 1\n[tracker.energy]\nw_s = 2.5\n[tracker.optimizer]\niterations = 20\n"
+      "[tracker]\nparticles = 1\n[tracker.energy]\nw_s = 2.5\nw_c_tracking = 0.75\n[tracker.optimizer]\niterations = 20\n"
       "[tracker.input]\nfar_mm = 700\n[pipeline]\ncpu_optimize = 1\n",
       "x.toml");
   EXPECT_EQ(c.source, "synthetic:pinch");
   EXPECT_EQ(c.log_level, LogLevel::kDebug);
   EXPECT_EQ(c.tracker.particles, 1);
   EXPECT_DOUBLE_EQ(c.tracker.weights.smoothness, 2.5);
+  EXPECT_DOUBLE_EQ(c.tracker.weights.tracking_collision, 0.75);
   EXPECT_EQ(c.tracker.optimizer.iterations, 20);
   EXPECT_DOUBLE_EQ(c.tracker.input.far_mm, 700.0);  // an integer is a fine number
   EXPECT_EQ(c.pipeline.cpu[static_cast<size_t>(Stage::kOptimize)], 1);

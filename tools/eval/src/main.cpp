@@ -213,7 +213,12 @@ int main(int argc, char** argv) {
   app.add_option("--iterations", config.optimizer.iterations, "optimizer iterations per particle")
       ->check(CLI::Range(1, 1000));
   app.add_option("--seed", config.seed, "random seed of the particle extrapolation");
-  app.add_option("--w-col", config.weights.collision, "w_c, weight of E_col (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
+  app.add_option("--w-col", config.weights.collision,
+                 "w_c, weight of E_col (Sec. 4.1) in the (re)start search and its checks and in depth-only tracking")
+      ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--w-col-tracking", config.weights.tracking_collision,
+                 "w_c while late fusion tracks (default 0.5, measured best; docs/TRACKER.md, \"w_c while tracking\")")
+      ->check(CLI::Range(0.0, 100.0));
   app.add_option("--w-lim", config.weights.limits, "w_l, weight of E_lim (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
   app.add_option("--w-smo", config.weights.smoothness, "w_s, weight of E_smo (Sec. 4.1)")->check(CLI::Range(0.0, 100.0));
   app.add_option("--coverage-cap", config.weights.coverage_cap,
@@ -267,7 +272,10 @@ int main(int argc, char** argv) {
   }
   if (energy == "late-fusion") config.mode = EnergyMode::kLateFusion;
   parse_handedness_mode(hand, &config.handedness);  // one of the names CLI11 checked
-  if (sim_only) config.weights.collision = config.weights.limits = config.weights.smoothness = 0.0;
+  if (sim_only) {
+    config.weights.collision = config.weights.tracking_collision = 0.0;
+    config.weights.limits = config.weights.smoothness = 0.0;
+  }
 
   try {
     if (!hand_profile.empty()) config.scale = load_hand_profile(hand_profile);

@@ -153,10 +153,11 @@ struct TrackerConfig {
 // an energy reads it (late fusion with w_f > 0: PoseTracker). Every TrackerInputs and HandsInputs
 // made for a tracker is made with this.
 DepthInputConfig input_config(const TrackerConfig& config);
-// The weights of `config`'s energies: E_free (w_f) and E_sim's coverage cap only with late fusion.
+// The weights of `config`'s energies: E_free (w_f), E_sim's coverage cap and the tracking w_c
+// (EnergyWeights::tracking_collision) only with late fusion.
 EnergyWeights mode_weights(const TrackerConfig& config);
 // The weights of the (re)start search and its checks (StartSearch): mode_weights() with E_sim as
-// eq. 6, without the coverage cap.
+// eq. 6, without the coverage cap, and the paper's w_c (EnergyWeights::collision).
 EnergyWeights search_weights(const TrackerConfig& config);
 
 // N points at the origin (Eigen leaves a default-constructed vector uninitialised).
