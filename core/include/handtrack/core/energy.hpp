@@ -50,7 +50,8 @@ struct EnergyWeights {
   // median 12-21 % more, its p95 and the lag less (docs/FILTER.md).
   double smoothness = kMeasuredSmoothness;
   // w_h of E_hand: ours (issue 14), the paper tracks one hand. 1.0 weighs an overlap with the other
-  // hand as much as the same overlap between two fingers of this hand (w_c).
+  // hand as much as the same overlap between two fingers of this hand at the paper's w_c (twice
+  // that at tracking_collision).
   double inter_hand = 1.0;
   // w_f of E_free: ours, the paper has no term for model parts over the background. Measured over
   // 0 / 1 / 2 / 3 / 5 / 10 on the broadened benchmark (docs/TRACKER.md, "Free space"): 1 was best
