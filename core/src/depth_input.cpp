@@ -105,6 +105,7 @@ const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::o
                                            const PixelLabeller* labeller, const std::vector<uint8_t>* foreign,
                                            const std::vector<float>* given_median) {
   out_.camera = depth.camera;
+  out_.mirrored = depth.mirrored;
   // Median, then the working volume (Sec. 4): 0 outside [near, far].
   const std::vector<float>& median =
       given_median != nullptr ? *given_median : steps_->median.apply(depth, config_.median_radius_px);
@@ -144,7 +145,14 @@ const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::o
 void FixedLabels::label(const DepthInput& input, std::vector<uint8_t>& labels) const {
   labels.assign(input.hand_mask.size(), 0);
   if (labels_ == nullptr || labels_->size() != labels.size()) return;
-  for (size_t i = 0; i < labels.size(); ++i) labels[i] = input.hand_mask[i] ? (*labels_)[i] : uint8_t{0};
+  const auto width = static_cast<size_t>(input.camera.width);
+  for (size_t i = 0; i < labels.size(); ++i) {
+    if (input.hand_mask[i] == 0) continue;
+    // Pixel (u, v) of a mirrored frame is pixel (width - 1 - u, v) of the camera's.
+    const size_t u = i % width;
+    const size_t source = input.mirrored ? i - u + (width - 1 - u) : i;
+    labels[i] = (*labels_)[source];
+  }
 }
 
 }  // namespace handtrack

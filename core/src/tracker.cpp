@@ -83,6 +83,7 @@ void mirror_depth(const DepthImage& in, DepthImage& out) {
   out.camera = in.camera;
   out.camera.cx = static_cast<double>(in.camera.width - 1) - in.camera.cx;
   mirror_rows(in.depth_mm, in.camera.width, out.depth_mm);
+  out.mirrored = !in.mirrored;
 }
 
 // A pose found in the mirrored frame, back in the camera's: every point and direction reflected.

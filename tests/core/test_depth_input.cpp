@@ -570,6 +570,45 @@ TEST(DepthInput, RegionsLabelledBackgroundLeaveTheHand) {
   EXPECT_EQ(leaf_area(labelled), leaf_area(kept));
 }
 
+TEST(DepthInput, GroundTruthLabelsFollowTheLeftHandsMirroredFrame) {
+  // A left hand is fitted in the mirrored frame (Tracker), so ground-truth labels given in the
+  // camera's frame must reach its input mirrored: the blob labelled thumb left of the image centre
+  // and little finger right of it. The right hand's input keeps the labels where they are; in the
+  // left hand's, pixel (u, v) carries the label of (width - 1 - u, v). (Until 2026-11-27 the left
+  // input got them unmirrored, and handtrack-eval --oracle-labels fitted left hands to labels of
+  // the wrong side.)
+  const auto cam = camera(320, 240);
+  const DepthImage img = blob_scene(cam, 400, false);
+  std::vector<uint8_t> labels(img.depth_mm.size());
+  for (size_t i = 0; i < labels.size(); ++i) {
+    labels[i] = static_cast<int>(i % static_cast<size_t>(cam.width)) < cam.width / 2 ? kThumbDistal : kLittleDistal;
+  }
+  const FixedLabels labeller(&labels);
+  InputRequest both;
+  both.left = true;
+  TrackerInputs inputs;
+  inputs.build(img, both, &labeller);
+  for (const Handedness hand : {Handedness::kRight, Handedness::kLeft}) {
+    const DepthInput* in = inputs.get(hand);
+    ASSERT_NE(in, nullptr);
+    ASSERT_TRUE(in->has_hand());
+    EXPECT_EQ(in->mirrored, hand == Handedness::kLeft);
+    int checked = 0;
+    int wrong = 0;
+    for (int v = 0; v < cam.height; ++v) {
+      for (int u = 0; u < cam.width; ++u) {
+        const auto i = static_cast<size_t>(v) * cam.width + u;
+        if (in->hand_mask[i] == 0) continue;
+        const int u_camera = hand == Handedness::kLeft ? cam.width - 1 - u : u;
+        wrong += in->pixel_labels[i] != labels[static_cast<size_t>(v) * cam.width + u_camera];
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 1000);
+    EXPECT_EQ(wrong, 0) << (hand == Handedness::kLeft ? "left" : "right") << " hand's input";
+  }
+}
+
 TEST(Projection, UnprojectInvertsProjectAndSigmaScalesWithInverseDepth) {
   const auto cam = camera(640, 480);
   std::mt19937_64 rng(5);

@@ -61,6 +61,10 @@ struct CameraIntrinsics {
 struct DepthImage {
   CameraIntrinsics camera;
   std::vector<float> depth_mm;
+  // The scene's mirror image about x = 0, as the camera would take it (Tracker: a left hand is
+  // tracked as the right hand of this image). Anything else given per pixel of the camera's own
+  // frame (ground-truth labels, FixedLabels) must be mirrored to go with it.
+  bool mirrored = false;
 
   [[nodiscard]] int width() const { return camera.width; }
   [[nodiscard]] int height() const { return camera.height; }

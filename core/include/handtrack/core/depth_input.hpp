@@ -70,6 +70,7 @@ struct ImageGaussian {
 
 struct DepthInput {
   CameraIntrinsics camera;
+  bool mirrored = false;              // built from a mirrored DepthImage (a left hand's input)
   std::vector<float> filtered_mm;     // median-filtered depth, 0 outside the working volume
   std::vector<uint8_t> hand_mask;     // 1 = pixel belongs to the segmented hand
   std::vector<uint8_t> pixel_labels;  // part label per pixel (0 = none); empty without a labeller
@@ -98,7 +99,8 @@ class PixelLabeller {
   virtual void label(const DepthInput& input, std::vector<uint8_t>& labels) const = 0;
 };
 
-// A PixelLabeller that copies a given label image (ground truth), for tests and ablations.
+// A PixelLabeller that copies a given label image (ground truth) of the camera's own frame, for
+// tests and ablations; mirrored left to right for a mirrored input (a left hand's, Tracker).
 class FixedLabels final : public PixelLabeller {
  public:
   explicit FixedLabels(const std::vector<uint8_t>* labels) : labels_(labels) {}
