@@ -585,8 +585,13 @@ double PoseEnergy::evaluate(const EnergyFrame& frame, const PoseParams& params, 
             weights_.smoothness * e.smoothness;
   if (other_hand) e.total -= weights_.inter_hand * e.inter_hand;
   if (weights_.free_space != 0.0) e.total -= weights_.free_space * e.free_space;
+  PoseGradient g_unseen = PoseGradient::Zero();
+  if (weights_.unseen_fingers != 0.0 && frame.unseen != nullptr) {
+    e.unseen = unseen_finger_energy(*frame.unseen, params, want ? &g_unseen : nullptr);
+    e.total -= weights_.unseen_fingers * e.unseen;
+  }
   if (want) {
-    *gradient = -weights_.limits * g_lim - weights_.smoothness * g_smo;
+    *gradient = -weights_.limits * g_lim - weights_.smoothness * g_smo - weights_.unseen_fingers * g_unseen;
     g_sim -= weights_.collision * g_col;
     if (other_hand) g_sim -= weights_.inter_hand * g_hand;
     if (weights_.free_space != 0.0) g_sim -= weights_.free_space * g_free;

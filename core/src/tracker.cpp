@@ -350,6 +350,7 @@ EnergyWeights mode_weights(const TrackerConfig& config) {
   if (config.mode == EnergyMode::kDepthOnly) {
     weights.free_space = 0.0;
     weights.coverage_cap = 0.0;
+    weights.unseen_fingers = 0.0;
   } else {
     weights.collision = config.weights.tracking_collision;
   }
@@ -434,6 +435,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   };
   if (!input.has_hand()) return no_hand();
   EnergyFrame frame{&model(), &input, nullptr, nullptr, other_hand_};
+  UnseenFingers unseen;
   OptimizerResult best{PoseParams::Zero(), -1e300};
   int winner = -1;
   bool guided_won = false;
@@ -450,6 +452,13 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   } else {
     frame.previous = &*previous_;
     frame.before_previous = before_previous_ ? &*before_previous_ : nullptr;
+    // Fingers the labels do not see on a hand facing the camera curl (unseen_fingers.hpp): weighed
+    // once a frame, from its labels and the previous pose.
+    if (depth_energy_.weights().unseen_fingers != 0.0 && !input.pixel_labels.empty()) {
+      scratch_.update(model(), *previous_);
+      unseen = unseen_fingers(input, scratch_);
+      frame.unseen = &unseen;
+    }
     const PoseParams velocity = before_previous_ ? PoseParams(*previous_ - *before_previous_) : PoseParams::Zero();
     std::normal_distribution<double> alpha(config_.extrapolation_mean, config_.extrapolation_sigma);
     for (int i = 0; i < config_.particles; ++i) {

@@ -230,6 +230,8 @@ const std::vector<Field>& fields() {
      "w_h, weight of the collision term between two hands E_hand (ours: the paper tracks one hand)", true},
     {"tracker.energy.w_f", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.free_space; }}, 0, 1000,
      "w_f, weight of the free-space term E_free: model parts over the background (ours, late fusion only; 0 = the paper's energy)", true},
+    {"tracker.energy.w_u", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.unseen_fingers; }}, 0, 1000,
+     "w_u, weight of E_unseen: fingers the part labels do not see on a hand facing the camera curl (ours, late fusion's tracking only; 0 = the paper's energy; docs/TRACKER.md)", true},
     {"tracker.energy.coverage_cap", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.coverage_cap; }}, 0, 100,
      "c, E_sim's coverage cap: an image Gaussian earns at most c times its own overlap, however many model parts cover it (ours, late fusion's tracking only, not its (re)starts; 0 = the paper's E_sim; docs/TRACKER.md)", true},
     {"tracker.energy.label_radius_mm", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.label_radius_mm; }}, 1, 5000,

@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <functional>
+#include <numbers>
 #include <random>
 
 namespace handtrack {
@@ -188,6 +190,21 @@ TEST_P(EnergyGradient, EveryTermMatchesFiniteDifferences) {
       [&](const PoseParams& p, PoseGradient* g) { return total_free.evaluate(seen_frame, p, hand, g); }, pose,
       "E with E_free");
 
+  // E_unseen, alone and in E, with a weight on every finger it acts on.
+  UnseenFingers unseen;
+  unseen.weight = {0.0, 0.3, 0.6, 0.9, 1.0};
+  EXPECT_GT(unseen_finger_energy(unseen, pose, nullptr), 1e-3);
+  expect_gradient_matches([&](const PoseParams& p, PoseGradient* g) { return unseen_finger_energy(unseen, p, g); },
+                          pose, "E_unseen");
+  EnergyWeights with_unseen;
+  with_unseen.unseen_fingers = 0.5;
+  const PoseEnergy total_unseen(SimilarityFactor::kDepth, with_unseen);
+  EnergyFrame unseen_frame = frame;
+  unseen_frame.unseen = &unseen;
+  expect_gradient_matches(
+      [&](const PoseParams& p, PoseGradient* g) { return total_unseen.evaluate(unseen_frame, p, hand, g); }, pose,
+      "E with E_unseen");
+
   // E_hand against another hand overlapping this one: beside it (a second right hand), and a left
   // hand (mirrored) reaching into it from the thumb side; its pose is one more random pose.
   const InterHandCollisionTerm inter;
@@ -229,6 +246,47 @@ TEST(EnergyTerms, SimilarityPeaksWhenModelSitsOnItsOwnImage) {
     hand.update(model, moved);
     EXPECT_LT(sim.evaluate(model, hand, input, nullptr), at_truth) << "shift " << shift.transpose();
   }
+}
+
+// u_f (unseen_fingers.hpp): 1 for a finger the labels do not see on a hand whose palm faces the
+// camera with the fingers across the view, 0 for a finger in full view, for the thumb, for a hand
+// seen edge-on or pointing at the camera, and without labels; E_unseen is 0 at the curled pose.
+TEST(EnergyTerms, UnseenFingersAreTheFingersTheLabelsMissOnAHandFacingTheCamera) {
+  const HandModel model = HandModel::default_adult();
+  DepthInput input;
+  const auto label = [&](int part, int pixels) { input.pixel_labels.insert(input.pixel_labels.end(), pixels, part); };
+  label(kPalm, 700);
+  label(part_label(kThumb, 1), 100);
+  label(part_label(kIndex, 0), 100);
+  label(part_label(kMiddle, 2), 80);
+  label(part_label(kLittle, 1), 20);  // 2 % of the labelled pixels: half seen
+  label(kBackground, 500);            // not counted
+  const auto weights = [&](const Eigen::Vector3d& rotation) {
+    PoseParams pose = PoseParams::Zero();
+    pose.segment<3>(3) = rotation;
+    return unseen_fingers(input, PosedHand(model, pose)).weight;
+  };
+  const auto facing = weights(Eigen::Vector3d::Zero());  // palm toward the camera, fingers up
+  EXPECT_EQ(facing[kThumb], 0.0);
+  EXPECT_EQ(facing[kIndex], 0.0);
+  EXPECT_EQ(facing[kMiddle], 0.0);
+  EXPECT_NEAR(facing[kRing], 1.0, 1e-12);
+  EXPECT_NEAR(facing[kLittle], 0.5, 1e-12);
+  const auto back = weights(Eigen::Vector3d(0, std::numbers::pi, 0));  // the back toward it
+  EXPECT_NEAR(back[kRing], 1.0, 1e-9);
+  const auto edge_on = weights(Eigen::Vector3d(0, std::numbers::pi / 2, 0));  // the thumb side toward it
+  EXPECT_NEAR(edge_on[kRing], 0.0, 1e-9);
+  const auto pointing = weights(Eigen::Vector3d(std::numbers::pi / 2, 0, 0));  // fingers along the view
+  EXPECT_NEAR(pointing[kRing], 0.0, 1e-9);
+  input.pixel_labels.clear();
+  EXPECT_EQ(weights(Eigen::Vector3d::Zero())[kRing], 0.0);
+
+  UnseenFingers unseen;
+  unseen.weight[kRing] = 1.0;
+  PoseParams curled = PoseParams::Zero();
+  for (int d = 1; d <= 3; ++d) curled[angle_param(kRing, d)] = kCurledFlexion[static_cast<size_t>(d - 1)];
+  EXPECT_EQ(unseen_finger_energy(unseen, curled, nullptr), 0.0);
+  EXPECT_NEAR(unseen_finger_energy(unseen, PoseParams::Zero(), nullptr), 1.3 * 1.3 + 1.6 * 1.6 + 0.9 * 0.9, 1e-12);
 }
 
 TEST(EnergyTerms, JointLimitIsZeroInsideAndQuadraticOutside) {

@@ -2,7 +2,8 @@
 // realistic inputs: seven synthetic 320x240 frames (one per Dexter 1 motion, noise and a body
 // behind the hand) and eight poses per frame near and off the true pose (energy_cases.hpp).
 //
-//   preprocessing   DepthInputBuilder::build without and with the part forest, the forest alone
+//   preprocessing   DepthInputBuilder::build without and with the part forest, the forest alone,
+//                   E_unseen's weights of a frame
 //   E_sim           energy + gradient per factor, the optimised term and the plain reference
 //   E               PoseEnergy::evaluate (posing the model, every term, the chain rule)
 //   E_hand          the two-hand collision term alone, and E with another hand touching or apart
@@ -101,6 +102,25 @@ void BM_ForestLabels(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_ForestLabels)->Unit(benchmark::kMicrosecond);
+
+// E_unseen's weights of one frame (unseen_fingers.hpp): the label histogram of the whole image and
+// the previous pose's axes, once a frame while late fusion tracks.
+void BM_UnseenFingers(benchmark::State& state) {
+  const PartForest* f = forest(state);
+  if (f == nullptr) return;
+  std::vector<DepthInput> labelled;
+  for (const auto& c : cases()) {
+    labelled.push_back(c.input);
+    f->label(c.input, labelled.back().pixel_labels);
+  }
+  size_t i = 0;
+  for (auto _ : state) {
+    const UnseenFingers u = unseen_fingers(labelled[i], posed_cases()[i * 8].hand);
+    benchmark::DoNotOptimize(u.weight.data());
+    i = (i + 1) % labelled.size();
+  }
+}
+BENCHMARK(BM_UnseenFingers)->Unit(benchmark::kMicrosecond);
 
 // E_sim and its gradient for one posed model: the optimised term (label: 0 depth, 1 label factor;
 // capped: with the shipped coverage cap, two passes, or eq. 6's one).

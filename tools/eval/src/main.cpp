@@ -224,6 +224,9 @@ int main(int argc, char** argv) {
   app.add_option("--coverage-cap", config.weights.coverage_cap,
                  "late fusion: c, E_sim's coverage cap while tracking (default 2, measured best; 0: the paper's E_sim; docs/TRACKER.md, \"E_sim's coverage cap\")")
       ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--w-unseen", config.weights.unseen_fingers,
+                 "late fusion: w_u, weight of E_unseen while tracking (default 0.01, measured best; 0: the paper's energy; docs/TRACKER.md, \"Unseen fingers curl\")")
+      ->check(CLI::Range(0.0, 100.0));
   app.add_option("--fusion-label-weight", config.fusion_label_weight,
                  "late fusion: label share lambda of the common energy that picks the particle")
       ->check(CLI::Range(0.0, 1.0));

@@ -3,9 +3,11 @@
 //
 //   E(Theta) = E_sim - w_c E_col - w_l E_lim - w_s E_smo                    (paper eq. 2)
 //
-// minus w_f E_free (ours): model parts over the background, which E_sim does not see; and, where
-// another hand is tracked at the same time (issue 14; ours, the paper has one hand), minus w_h
-// E_hand, the same Gaussian overlap as E_col between this hand and the other (fixed) one.
+// minus w_f E_free (ours): model parts over the background, which E_sim does not see; minus w_u
+// E_unseen (ours, unseen_fingers.hpp): fingers the labels do not see on a hand facing the camera
+// are curled; and, where another hand is tracked at the same time (issue 14; ours, the paper has
+// one hand), minus w_h E_hand, the same Gaussian overlap as E_col between this hand and the other
+// (fixed) one.
 //
 // One class per term; each returns its value and adds its analytic gradient (d term / d Theta)
 // into a PoseGradient when asked. The detection-guided energy of Sec. 4.3 is the same energy with
@@ -15,6 +17,7 @@
 #include "handtrack/core/hand_model.hpp"
 #include "handtrack/core/kinematics.hpp"
 #include "handtrack/core/pose.hpp"
+#include "handtrack/core/unseen_fingers.hpp"
 
 #include <vector>
 
@@ -33,6 +36,10 @@ inline constexpr double kPapersSmoothness = 1.0;  // w_s of Sec. 4.1
 // w_c while late fusion tracks, measured on the broadened benchmark (docs/TRACKER.md, "w_c while
 // tracking"): 0.5 against the paper's 1 on each of four sets of subjects; 0.25 and 2 were worse.
 inline constexpr double kMeasuredTrackingCollision = 0.5;
+
+// w_u measured on the broadened benchmark (docs/TRACKER.md, "Unseen fingers curl"): the back view
+// 21.0 -> 17.2 and 20.7 -> 17.7 mm on two sets of three subjects.
+inline constexpr double kMeasuredUnseenFingers = 0.01;
 
 struct EnergyWeights {
   // w_c, Sec. 4.1 (1): the (re)start search and its checks, depth-only tracking and the calibration.
@@ -57,6 +64,9 @@ struct EnergyWeights {
   // 0 / 1 / 2 / 3 / 5 / 10 on the broadened benchmark (docs/TRACKER.md, "Free space"): 1 was best
   // over six seeds; 0 is the paper's energy. PoseTracker uses it with late fusion only.
   double free_space = 1.0;
+  // w_u of E_unseen: ours (unseen_fingers.hpp), the paper has no prior on fingers it cannot see.
+  // PoseTracker uses it while late fusion tracks (it needs the part labels and a previous pose).
+  double unseen_fingers = kMeasuredUnseenFingers;
   // c of E_sim's coverage cap: ours, the paper's eq. 6 has none. An image Gaussian q earns at most
   // c D_qq, however many model Gaussians overlap it, so that model parts laid over a surface that
   // other parts already explain (fingers folded onto the back of the hand, where the camera sees
@@ -228,6 +238,7 @@ struct EnergyBreakdown {
   double smoothness = 0.0;
   double inter_hand = 0.0;  // E_hand; 0 without EnergyFrame::other_hand
   double free_space = 0.0;  // E_free; 0 while w_f = 0
+  double unseen = 0.0;      // E_unseen; 0 without EnergyFrame::unseen
   double total = 0.0;
 };
 
@@ -238,6 +249,7 @@ struct EnergyFrame {
   const PoseParams* previous = nullptr;         // Theta^{t-1}; E_smo is off when either is null
   const PoseParams* before_previous = nullptr;  // Theta^{t-2}
   const HandObstacle* other_hand = nullptr;     // E_hand is off when null
+  const UnseenFingers* unseen = nullptr;        // E_unseen is off when null
 };
 
 class PoseEnergy {
@@ -245,9 +257,9 @@ class PoseEnergy {
   // `label_share`: s of SimilarityFactor::kDepthAndLabel (unused by the other factors).
   PoseEnergy(SimilarityFactor factor, const EnergyWeights& weights, double label_share = 0.5);
 
-  // E(Theta) (eq. 2; minus w_f E_free, and minus w_h E_hand when frame.other_hand is set); adds
-  // dE/dTheta into *gradient (which it zeroes first) when not null.
-  // `hand` is scratch space for the posed model.
+  // E(Theta) (eq. 2; minus w_f E_free, minus w_u E_unseen when frame.unseen is set, and minus w_h
+  // E_hand when frame.other_hand is set); adds dE/dTheta into *gradient (which it zeroes first)
+  // when not null. `hand` is scratch space for the posed model.
   double evaluate(const EnergyFrame& frame, const PoseParams& params, PosedHand& hand, PoseGradient* gradient,
                   EnergyBreakdown* breakdown = nullptr) const;
   [[nodiscard]] const EnergyWeights& weights() const { return weights_; }

@@ -1,0 +1,52 @@
+#pragma once
+// Unseen fingers curl (ours, not in the paper): a prior on the flexion of a finger the part labels
+// do not see.
+//
+// With the back of the hand toward the camera, a finger curled into the palm is behind the hand:
+// the camera sees none of it, E_sim (Sec. 4.1) is indifferent to where it is, E_smo carries on its
+// last motion, and E_free only charges what lies over the background. So curled fingers were
+// fitted stretched out behind the back of the hand (fists seen from the back: 25-34 mm,
+// docs/TRACKER.md). A finger lying across the view, on a hand whose flat side faces the camera, is
+// seen unless it is curled behind the hand; so where the labels find none of a finger on such a
+// hand, it is curled:
+//
+//   E_unseen = sum_f u_f sum_{d = 1..3} (theta_{f,d} - theta^curl_d)^2        (f: index..little)
+//   u_f = g (1 - min(1, s_f / s_0)),   g = n_z^2 (1 - |a_z|)
+//
+// s_f: the share of the labelled hand pixels the forest gives finger f's parts; s_0 = 4 % (a finger
+// in full view holds 8-15 % of them); n, a: the palm normal and the finger axis (camera frame) of
+// the previous pose, so g is 1 for a hand whose flat side faces the camera with the fingers across
+// the view, and 0 for a hand seen edge-on (the fingers stand behind one another) or pointing along
+// the view (an outstretched finger can hide behind the hand). Squared in n_z: with |n_z| the side
+// view lost 0.7-1.4 mm on each of three sets of subjects (fingers behind one another on a hand
+// turned only part of the way), with n_z^2 it does not (docs/TRACKER.md, "Unseen fingers curl"). theta^curl is a relaxed fist. The
+// weights hold for a frame (they do not depend on the pose being fitted), so E_unseen is a plain
+// quadratic in Theta with an exact gradient. The thumb is left out: the labels see it in every
+// view it is curled in. Late fusion only (labels), and only while tracking (a previous pose).
+
+#include "handtrack/core/depth_input.hpp"
+#include "handtrack/core/hand_layout.hpp"
+#include "handtrack/core/kinematics.hpp"
+#include "handtrack/core/pose.hpp"
+
+#include <array>
+
+namespace handtrack {
+
+// The flexion (flex1..flex3, radians) of a relaxed fist, inside every finger's joint limits.
+inline constexpr std::array<double, 3> kCurledFlexion = {1.3, 1.6, 0.9};
+// s_0: a finger whose parts hold this share of the labelled hand pixels counts as fully seen.
+inline constexpr double kSeenFingerShare = 0.04;
+
+// u_f of one frame (0 for the thumb).
+struct UnseenFingers {
+  std::array<double, kNumFingers> weight{};
+};
+
+// u_f from the frame's part labels and the previous pose (posed); all 0 without labels.
+UnseenFingers unseen_fingers(const DepthInput& input, const PosedHand& previous);
+
+// E_unseen at `params`; adds dE_unseen/dTheta into *gradient when not null.
+double unseen_finger_energy(const UnseenFingers& unseen, const PoseParams& params, PoseGradient* gradient);
+
+}  // namespace handtrack
