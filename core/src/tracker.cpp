@@ -453,8 +453,9 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     frame.previous = &*previous_;
     frame.before_previous = before_previous_ ? &*before_previous_ : nullptr;
     // Fingers the labels do not see on a hand facing the camera curl (unseen_fingers.hpp): weighed
-    // once a frame, from its labels and the previous pose.
-    if (depth_energy_.weights().unseen_fingers != 0.0 && !input.pixel_labels.empty()) {
+    // once a frame, from its labels and the previous pose. Not beside another hand, which can hide
+    // an outstretched finger as well (two_cross's left hand behind the right: 9.9 -> 21.6 mm).
+    if (depth_energy_.weights().unseen_fingers != 0.0 && !input.pixel_labels.empty() && other_hand_ == nullptr) {
       scratch_.update(model(), *previous_);
       unseen = unseen_fingers(input, scratch_);
       frame.unseen = &unseen;
