@@ -13,16 +13,18 @@
 //   E_unseen = sum_f u_f sum_{d = 1..3} (theta_{f,d} - theta^curl_d)^2        (f: index..little)
 //   u_f = g (1 - min(1, s_f / s_0)),   g = n_z^2 (1 - |a_z|)
 //
-// s_f: the share of the labelled hand pixels the forest gives finger f's parts; s_0 = 4 % (a finger
-// in full view holds 8-15 % of them); n, a: the palm normal and the finger axis (camera frame) of
-// the previous pose, so g is 1 for a hand whose flat side faces the camera with the fingers across
-// the view, and 0 for a hand seen edge-on (the fingers stand behind one another) or pointing along
-// the view (an outstretched finger can hide behind the hand). Squared in n_z: with |n_z| the side
-// view lost 0.7-1.4 mm on each of three sets of subjects (fingers behind one another on a hand
-// turned only part of the way), with n_z^2 it does not (docs/TRACKER.md, "Unseen fingers curl"). theta^curl is a relaxed fist. The
-// weights hold for a frame (they do not depend on the pose being fitted), so E_unseen is a plain
-// quadratic in Theta with an exact gradient. The thumb is left out: the labels see it in every
-// view it is curled in. Late fusion only (labels), and only while tracking (a previous pose).
+// s_f: the share of the labelled hand pixels the forest gives finger f's parts; s_0 = 4 % (in an
+// open hand seen palm-on, index to little hold 6-12 % each); n, a: the palm normal and the finger
+// axis (camera frame) of the previous pose, so g is 1 for a hand whose flat side faces the camera
+// with the fingers across the view, and 0 for a hand seen edge-on (the fingers stand behind one
+// another) or pointing along the view (an outstretched finger can hide behind the hand). Squared in
+// n_z: with |n_z| the side view lost 0.7-1.4 mm on each of three sets of subjects (fingers behind
+// one another on a hand turned only part of the way), with n_z^2 -0.4 to +0.9 mm (docs/TRACKER.md,
+// "Unseen fingers curl"). theta^curl is a relaxed fist. The weights hold for a frame (they do not
+// depend on the pose being fitted), so E_unseen is a plain quadratic in Theta with an exact
+// gradient. The thumb is left out (its curl is not a fist's; not measured with it). Late fusion
+// only (labels), only while tracking (a previous pose), and not beside another hand (it can hide
+// an outstretched finger too).
 
 #include "handtrack/core/depth_input.hpp"
 #include "handtrack/core/hand_layout.hpp"
