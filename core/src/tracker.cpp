@@ -456,8 +456,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     // once a frame, from its labels and the previous pose. Not beside another hand, which can hide
     // an outstretched finger as well (two_cross's left hand behind the right: 9.9 -> 21.6 mm).
     if (depth_energy_.weights().unseen_fingers != 0.0 && !input.pixel_labels.empty() && other_hand_ == nullptr) {
-      scratch_.update(model(), *previous_);
-      unseen = unseen_fingers(input, scratch_);
+      unseen = unseen_fingers(input, *previous_);
       frame.unseen = &unseen;
     }
     const PoseParams velocity = before_previous_ ? PoseParams(*previous_ - *before_previous_) : PoseParams::Zero();

@@ -1,5 +1,7 @@
 #include "handtrack/core/unseen_fingers.hpp"
 
+#include "handtrack/core/kinematics.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -7,7 +9,7 @@
 
 namespace handtrack {
 
-UnseenFingers unseen_fingers(const DepthInput& input, const PosedHand& previous) {
+UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous) {
   UnseenFingers unseen;
   // Per label value, over the image: the labels are 0 off the hand (most of the image), so eight
   // at a time are skipped while they are all 0.
@@ -30,7 +32,7 @@ UnseenFingers unseen_fingers(const DepthInput& input, const PosedHand& previous)
   }
   if (labelled == 0) return unseen;
   // Columns of camera_R_hand: the hand's y axis runs along the fingers, its z axis out of the palm.
-  const Eigen::Matrix3d& r = previous.camera_R_hand();
+  const Eigen::Matrix3d r = hand_rotation(previous);
   const double facing = r.col(2).z() * r.col(2).z();
   const double across_view = facing * (1.0 - std::abs(r.col(1).z()));
   for (int f = kIndex; f < kNumFingers; ++f) {

@@ -252,7 +252,6 @@ TEST(EnergyTerms, SimilarityPeaksWhenModelSitsOnItsOwnImage) {
 // camera with the fingers across the view, 0 for a finger in full view, for the thumb, for a hand
 // seen edge-on or pointing at the camera, and without labels; E_unseen is 0 at the curled pose.
 TEST(EnergyTerms, UnseenFingersAreTheFingersTheLabelsMissOnAHandFacingTheCamera) {
-  const HandModel model = HandModel::default_adult();
   DepthInput input;
   const auto label = [&](int part, int pixels) { input.pixel_labels.insert(input.pixel_labels.end(), pixels, part); };
   label(kPalm, 700);
@@ -264,7 +263,7 @@ TEST(EnergyTerms, UnseenFingersAreTheFingersTheLabelsMissOnAHandFacingTheCamera)
   const auto weights = [&](const Eigen::Vector3d& rotation) {
     PoseParams pose = PoseParams::Zero();
     pose.segment<3>(3) = rotation;
-    return unseen_fingers(input, PosedHand(model, pose)).weight;
+    return unseen_fingers(input, pose).weight;
   };
   const auto facing = weights(Eigen::Vector3d::Zero());  // palm toward the camera, fingers up
   EXPECT_EQ(facing[kThumb], 0.0);

@@ -28,7 +28,6 @@
 
 #include "handtrack/core/depth_input.hpp"
 #include "handtrack/core/hand_layout.hpp"
-#include "handtrack/core/kinematics.hpp"
 #include "handtrack/core/pose.hpp"
 
 #include <array>
@@ -45,8 +44,9 @@ struct UnseenFingers {
   std::array<double, kNumFingers> weight{};
 };
 
-// u_f from the frame's part labels and the previous pose (posed); all 0 without labels.
-UnseenFingers unseen_fingers(const DepthInput& input, const PosedHand& previous);
+// u_f from the frame's part labels and the previous pose (only its global rotation is read); all 0
+// without labels.
+UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous);
 
 // E_unseen at `params`; adds dE_unseen/dTheta into *gradient when not null.
 double unseen_finger_energy(const UnseenFingers& unseen, const PoseParams& params, PoseGradient* gradient);
