@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 
@@ -185,6 +186,49 @@ TEST_F(EvalCli, ATwoHandSequenceIsScoredPerHandAndAOneHandOneOnlyWhenAsked) {
   EXPECT_EQ(one.at("frames_without_pose"), 4);
   EXPECT_EQ(eval(&err, pair + " --max-hands 3"), 1);
   EXPECT_NE(err.find("--max-hands"), std::string::npos) << err;
+}
+
+// A recording annotated only with the hand it shows (hand.json, no fingertips: a real recording) is
+// scored for its handedness alone: the share of frames reported as that hand, and no fingertip
+// figures ("-" in the table, null in the JSON) rather than nan or 0 %. Tracked hands are matched to
+// a sequence's by their fingertips, so a two-hand sequence without them, or --max-hands 2, is
+// refused with one line.
+TEST_F(EvalCli, ARecordingAnnotatedOnlyWithItsHandIsScoredForHandedness) {
+  handtrack::synth::SynthOptions o;
+  o.motion = "pinch";
+  o.hand = handtrack::synth::Handedness::kLeft;
+  o.frames = 40;
+  handtrack::synth::SyntheticCamera cam(o);
+  const fs::path left = dir_ / "left";
+  {
+    handtrack::SequenceWriter writer(left, cam.camera());
+    for (int f = 0; f < o.frames; ++f) writer.write_depth(f, cam.render(f).depth);
+    writer.flush();
+  }
+  std::ofstream(left / "hand.json") << nlohmann::json{{"hands", {"left"}}}.dump();
+  const fs::path json = dir_ / "eval.json";
+  std::string err;
+  ASSERT_EQ(eval(&err, "'" + left.string() + "' --energy depth-only --json '" + json.string() + "'"), 0) << err;
+  std::ifstream in(json);
+  const auto one = nlohmann::json::parse(in).at("sequences").at(0);
+  EXPECT_TRUE(one.at("mean_fingertip_error_mm").is_null());
+  EXPECT_TRUE(one.at("pct_frames_below_mm").at("30").is_null());
+  EXPECT_EQ(one.at("frames_scored"), 0);
+  EXPECT_GE(one.at("handedness").at("pct_frames_correct").get<double>(), 90.0) << one.dump();
+  std::ifstream table(dir_ / "stdout.txt");
+  const std::string text((std::istreambuf_iterator<char>(table)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find("nan"), std::string::npos) << text;
+  EXPECT_NE(text.find("hand_%"), std::string::npos) << text;
+
+  std::ofstream(left / "hand.json", std::ios::trunc) << nlohmann::json{{"hands", {"right", "left"}}}.dump();
+  EXPECT_EQ(eval(&err, "'" + left.string() + "' --energy depth-only"), 1);
+  EXPECT_NE(err.find("no groundtruth.csv: tracked hands are matched to the sequence's by their annotated fingertips"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  std::ofstream(left / "hand.json", std::ios::trunc) << nlohmann::json{{"hands", {"left"}}}.dump();
+  EXPECT_EQ(eval(&err, "'" + left.string() + "' --energy depth-only --max-hands 2"), 1);
+  EXPECT_NE(err.find("without --max-hands"), std::string::npos) << err;
 }
 
 // The working volume is the user's to set: a hand beyond --far-mm is not seen, and an empty volume

@@ -292,12 +292,20 @@ int main(int argc, char** argv) {
     std::vector<eval::SequenceScore> scores;
     std::vector<SequenceReader> readers;
     size_t total_frames = 0;
+    const bool hands_asked = app.count("--max-hands") > 0 && max_hands > 1;
     for (const auto& d : dirs) {
       readers.emplace_back(d);
-      if (!readers.back().has_groundtruth()) {
+      // Without annotated fingertips a sequence is scored for its handedness alone, where its
+      // hand.json names the one hand it shows (a real recording labelled only with its hand).
+      // Tracked hands are matched to several by their fingertips, so not with --max-hands 2.
+      const std::size_t hands = readers.back().hands().size();
+      if (!readers.back().has_groundtruth() && (hands != 1 || hands_asked)) {
         const bool present = std::filesystem::exists(std::filesystem::path(d) / "groundtruth.csv");
-        throw std::runtime_error(d + (present ? "/groundtruth.csv: no annotated frame in it, nothing to score"
-                                              : ": no groundtruth.csv, nothing to score"));
+        throw std::runtime_error(
+            d + (present ? "/groundtruth.csv: no annotated frame in it" : ": no groundtruth.csv") +
+            (hands == 0 ? " and no hand.json naming its hand, nothing to score"
+                        : ": tracked hands are matched to the sequence's by their annotated fingertips (one hand "
+                          "without them is scored for its handedness alone, without --max-hands)"));
       }
       if (oracle_labels && readers.back().frame_count() > 0 && !readers.back().labels(0)) {
         throw std::runtime_error(d + ": no labels/, needed by --oracle-labels");
@@ -317,7 +325,6 @@ int main(int argc, char** argv) {
     loop.tips = &tips_out;
     loop.progress = &progress;
     loop.total = total_frames;
-    const bool hands_asked = app.count("--max-hands") > 0 && max_hands > 1;
     for (const auto& reader : readers) {
       const SequenceInfo info = read_sequence_info(reader);
       scores.push_back(reader.hand_count() > 1 || hands_asked ? evaluate_hands(reader, info, config, max_hands, loop)
@@ -326,10 +333,16 @@ int main(int argc, char** argv) {
       scores.back().motion = info.motion;
     }
     const auto total = eval::overall(scores);
-    // A mean over no frame is not a result: every annotated frame got no pose (or a NaN one).
-    if (total.scored == 0) {
+    // A mean over no frame is not a result: every annotated frame got no pose (or a NaN one). Nor is
+    // a handedness over no frame, where nothing is annotated.
+    const int annotated = total.scored + total.without_pose;
+    if (annotated > 0 && total.scored == 0) {
       throw std::runtime_error("no frame could be scored: the tracker reported no hand in all " +
-                               std::to_string(total.frames) + " frames with ground truth");
+                               std::to_string(annotated) + " frames with ground truth");
+    }
+    if (annotated == 0 && total.hand_known_frames == 0) {
+      throw std::runtime_error("no frame could be scored: no fingertip is annotated, and the tracker reported no hand "
+                               "in any of the " + std::to_string(total.frames) + " frames");
     }
     const auto groups = eval::group_scores(scores);
     const auto json = eval::to_json(scores, total, groups);

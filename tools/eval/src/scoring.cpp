@@ -60,7 +60,7 @@ void summarise(SequenceScore& s) {
   }
   s.mean_error_mm = s.scored > 0 ? sum / s.scored : std::numeric_limits<double>::quiet_NaN();
   for (size_t k = 0; k < kThresholdsMm.size(); ++k) {
-    s.pct_below[k] = annotated > 0 ? 100.0 * below[k] / annotated : 0.0;
+    s.pct_below[k] = annotated > 0 ? 100.0 * below[k] / annotated : std::numeric_limits<double>::quiet_NaN();
   }
 }
 }  // namespace
@@ -286,13 +286,24 @@ std::string format_table(const std::vector<SequenceScore>& sequences, const Sequ
                          const std::vector<ScoreGroups>& groups) {
   std::string text;
   char line[160];
-  std::snprintf(line, sizeof line, "%-14s %7s %9s %6s %6s %6s %6s %8s %7s\n", "sequence", "frames", "mean_mm", "<15",
-                "<20", "<25", "<30", "fps", "guided");
+  std::snprintf(line, sizeof line, "%-14s %7s %9s %6s %6s %6s %6s %8s %7s %7s\n", "sequence", "frames", "mean_mm",
+                "<15", "<20", "<25", "<30", "fps", "guided", "hand_%");
   text += line;
+  // "-" for a figure over no frame: the mean where no annotated frame got a pose, the share of frames
+  // reported as the hand shown where the sequences do not say which it is (hand.json).
+  const auto figure = [](double value, const char* format) {
+    char cell[32];
+    if (!std::isfinite(value)) return std::string("-");
+    std::snprintf(cell, sizeof cell, format, value);
+    return std::string(cell);
+  };
   const auto row = [&](const SequenceScore& s) {
-    std::snprintf(line, sizeof line, "%-14s %7d %9.2f %6.1f %6.1f %6.1f %6.1f %8.1f %7d\n", s.name.c_str(), s.frames,
-                  s.mean_error_mm, s.pct_below[0], s.pct_below[1], s.pct_below[2], s.pct_below[3], s.fps,
-                  s.guided_wins);
+    const double hand = s.hand_known_frames > 0 ? 100.0 * s.hand_correct / s.hand_known_frames
+                                                : std::numeric_limits<double>::quiet_NaN();
+    std::snprintf(line, sizeof line, "%-14s %7d %9s %6s %6s %6s %6s %8.1f %7d %7s\n", s.name.c_str(), s.frames,
+                  figure(s.mean_error_mm, "%.2f").c_str(), figure(s.pct_below[0], "%.1f").c_str(),
+                  figure(s.pct_below[1], "%.1f").c_str(), figure(s.pct_below[2], "%.1f").c_str(),
+                  figure(s.pct_below[3], "%.1f").c_str(), s.fps, s.guided_wins, figure(hand, "%.1f").c_str());
     text += line;
   };
   for (const auto& s : sequences) row(s);
@@ -332,12 +343,12 @@ std::string format_table(const std::vector<SequenceScore>& sequences, const Sequ
 
 nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const SequenceScore& total,
                        const std::vector<ScoreGroups>& groups) {
-  const auto pct = [](const SequenceScore& s) {
+  const auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  const auto pct = [&](const SequenceScore& s) {
     nlohmann::json j = nlohmann::json::object();
-    for (size_t k = 0; k < kThresholdsMm.size(); ++k) j[std::to_string(kThresholdsMm[k])] = s.pct_below[k];
+    for (size_t k = 0; k < kThresholdsMm.size(); ++k) j[std::to_string(kThresholdsMm[k])] = number(s.pct_below[k]);
     return j;
   };
-  const auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   // Of the frames with a pose: the share reported left, and where the truth is known, right.
   const auto hands = [&](const SequenceScore& s) {
     const auto share = [&](int n, int of) { return of > 0 ? number(100.0 * n / of) : nlohmann::json(nullptr); };
