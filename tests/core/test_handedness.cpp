@@ -9,6 +9,7 @@
 //   230536/170 the palm-facing right hand explains slightly more of the depth as a left hand seen
 //   from the back (a model of isotropic Gaussians is nearly the same seen from either side), the
 //   failure the issue "Every hand, every view" still has to remove.
+#include "handtrack/core/hands_tracker.hpp"
 #include "handtrack/core/part_forest.hpp"
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/tracker.hpp"
@@ -185,6 +186,35 @@ TEST(RealStillHand, StaysTheRightHandWhileTracked) {
   }
   EXPECT_GE(frames, 6) << "frames with a hand in the working volume";
   EXPECT_GE(12 * still_right, 11 * frames) << still_right << " of " << frames << " still frames stayed a right hand";
+}
+
+// The same still frames as handtrackd tracks them: HandsTracker with room for one hand (the frame
+// shared out first), the last of 31 shown frames. Measured (2026-11-28): 17 of the 19 frames with
+// a hand right at seed 1, 15-16 at seeds 2-4. 231615/20 is a left hand at every seed: the forest
+// labels its thumb a little finger, and the fit is a left hand's palm with the thumb on the wrong
+// side (docs/TRACKER.md, "Real frames"); 230536/170 (hand, arm and torso one surface) goes either
+// way. The issue's goal, every frame right, is not met on this path; the bound guards what is.
+TEST(RealStillHand, MostStayTheRightHandAsHandtrackdTracksThem) {
+  const std::vector<fs::path> files = sr305_frames();
+  if (files.empty()) GTEST_SKIP() << "shared data absent: " << kSr305Root;
+  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  constexpr int kShown = 31;
+  int frames = 0;
+  int still_right = 0;
+  for (const fs::path& file : files) {
+    const DepthImage depth = read_sr305_frame(file);
+    TrackerConfig config = sr305_config(EnergyMode::kLateFusion);
+    config.max_hands = 1;
+    HandsTracker tracker(config);
+    HandsOutput out;
+    for (int k = 0; k < kShown; ++k) out = tracker.track(depth, &forest);
+    if (out.count == 0) continue;  // beyond the working volume
+    ++frames;
+    still_right += out.hands[0].handedness == Handedness::kRight ? 1 : 0;
+    if (out.hands[0].handedness != Handedness::kRight) std::cout << "a left hand as handtrackd tracks: " << sr305_name(file) << "\n";
+  }
+  EXPECT_GE(frames, 15) << "frames with a hand in the working volume";
+  EXPECT_GE(6 * still_right, 5 * frames) << still_right << " of " << frames << " still frames reported as the right hand";
 }
 
 // A hand whose first trial chose the wrong hand on a fist (fingercount starts as one, which either
