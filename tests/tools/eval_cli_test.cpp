@@ -215,6 +215,7 @@ TEST_F(EvalCli, ARecordingAnnotatedOnlyWithItsHandIsScoredForHandedness) {
   EXPECT_TRUE(one.at("pct_frames_below_mm").at("30").is_null());
   EXPECT_EQ(one.at("frames_scored"), 0);
   EXPECT_GE(one.at("handedness").at("pct_frames_correct").get<double>(), 90.0) << one.dump();
+  EXPECT_GE(one.at("handedness").at("frames_with_pose").get<int>(), 36) << one.dump();
   std::ifstream table(dir_ / "stdout.txt");
   const std::string text((std::istreambuf_iterator<char>(table)), std::istreambuf_iterator<char>());
   EXPECT_EQ(text.find("nan"), std::string::npos) << text;

@@ -352,7 +352,8 @@ nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const Sequen
   // Of the frames with a pose: the share reported left, and where the truth is known, right.
   const auto hands = [&](const SequenceScore& s) {
     const auto share = [&](int n, int of) { return of > 0 ? number(100.0 * n / of) : nlohmann::json(nullptr); };
-    nlohmann::json j = {{"pct_frames_left", share(s.left_frames, s.posed_frames)},
+    nlohmann::json j = {{"frames_with_pose", s.posed_frames},
+                        {"pct_frames_left", share(s.left_frames, s.posed_frames)},
                         {"pct_frames_correct", share(s.hand_correct, s.hand_known_frames)}};
     if (s.expected_hand) j["expected"] = to_string(*s.expected_hand);
     return j;
