@@ -156,15 +156,6 @@ INSTANTIATE_TEST_SUITE_P(DepthOnlyAndShipped, RealHands,
                            return std::string(c.param.mode == EnergyMode::kLateFusion ? "late_fusion" : "depth_only");
                          });
 
-// A real hand held still: each SR305 frame shown 31 times in a row to one tracker (a (re)start,
-// its handedness trial, then tracking, with the trials again of a mediocre fit) is still reported
-// as the right hand it is at the end, in the shipped configuration. What it guards is the tracked
-// fit's own energy: the (re)start and its trial chose the right hand on all 17 frames, but with
-// E_sim as in eq. 6 while tracking (no coverage cap) the tracked fits of 230536/30, 230536/150 and
-// 231615/60 turned to the left hand within the 30 frames; with the shipped cap none did
-// (docs/TRACKER.md, "E_sim's coverage cap"). It guards the search's w_c too: with the tracking w_c
-// of 0.5 in the (re)start search as well, 13 of 17 stayed right (docs/TRACKER.md, "w_c while
-// tracking"). The bound: at most one frame in 12 turned.
 // Each SR305 frame shown kStillShown times in a row to a fresh tracker (`shown(depth)`: the hand
 // it reports at the end, nullopt for none): how many frames had a hand in the working volume, and
 // how many of them were the right hand at the end. The others are printed.
@@ -186,6 +177,15 @@ StillFrames still_frames(const std::vector<fs::path>& files, Shown&& shown) {
   return count;
 }
 
+// A real hand held still: each SR305 frame shown 31 times in a row to one tracker (a (re)start,
+// its handedness trial, then tracking, with the trials again of a mediocre fit) is still reported
+// as the right hand it is at the end, in the shipped configuration. What it guards is the tracked
+// fit's own energy: the (re)start and its trial chose the right hand on all 17 frames, but with
+// E_sim as in eq. 6 while tracking (no coverage cap) the tracked fits of 230536/30, 230536/150 and
+// 231615/60 turned to the left hand within the 30 frames; with the shipped cap none did
+// (docs/TRACKER.md, "E_sim's coverage cap"). It guards the search's w_c too: with the tracking w_c
+// of 0.5 in the (re)start search as well, 13 of 17 stayed right (docs/TRACKER.md, "w_c while
+// tracking"). The bound: at most one frame in 12 turned.
 TEST(RealStillHand, StaysTheRightHandWhileTracked) {
   const std::vector<fs::path> files = sr305_frames();
   if (files.empty()) GTEST_SKIP() << "shared data absent: " << kSr305Root;
