@@ -327,9 +327,11 @@ std::string format_table(const std::vector<SequenceScore>& sequences, const Sequ
                                 (h.expected_hand ? to_string(*h.expected_hand) : "?");
       const double side = h.hand_known_frames > 0 ? 100.0 * h.hand_correct / h.hand_known_frames
                                                   : std::numeric_limits<double>::quiet_NaN();
-      std::snprintf(line, sizeof line, "%-22s %7d %9.2f %6.1f %6.1f %6.1f %6.1f %7d %7.1f %6d\n", label.c_str(),
-                    h.frames, h.mean_error_mm, h.pct_below[0], h.pct_below[1], h.pct_below[2], h.pct_below[3],
-                    h.without_pose, side, h.identity_swaps);
+      std::snprintf(line, sizeof line, "%-22s %7d %9s %6s %6s %6s %6s %7d %7s %6d\n", label.c_str(), h.frames,
+                    figure(h.mean_error_mm, "%.2f").c_str(), figure(h.pct_below[0], "%.1f").c_str(),
+                    figure(h.pct_below[1], "%.1f").c_str(), figure(h.pct_below[2], "%.1f").c_str(),
+                    figure(h.pct_below[3], "%.1f").c_str(), h.without_pose, figure(side, "%.1f").c_str(),
+                    h.identity_swaps);
       text += line;
     }
     std::snprintf(line, sizeof line, "  %s: %d frames with a phantom hand (%d hands)\n", s.name.c_str(),

@@ -35,9 +35,9 @@ struct SequenceScore {
   int without_pose = 0;        // annotated frames where the tracker reported no hand
   int nan_poses = 0;           // frames whose pose had a non-finite number (must stay 0)
   int guided_wins = 0;         // late fusion: frames the detection-guided particle won
-  double mean_error_mm = 0.0;  // over scored frames
+  double mean_error_mm = 0.0;  // over scored frames (NaN: none)
   double max_error_mm = 0.0;
-  std::array<double, kThresholdsMm.size()> pct_below{};  // over annotated frames
+  std::array<double, kThresholdsMm.size()> pct_below{};  // over annotated frames (NaN: none)
   double fps = 0.0;            // single-threaded tracking rate (preprocessing + optimisation)
   // Handedness (SPEC.md: DIR/hand.json says which hand a sequence shows): of the frames with a
   // pose, how many were reported as a left hand, and, where the sequence says, as the right hand.
