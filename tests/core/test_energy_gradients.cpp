@@ -262,7 +262,7 @@ TEST(EnergyTerms, UnseenFingersAreTheFingersTheLabelsMissOnAHandFacingTheCamera)
   label(kBackground, 500);            // not counted
   const auto weights = [&](const Eigen::Vector3d& rotation) {
     PoseParams pose = PoseParams::Zero();
-    pose.segment<3>(3) = rotation;
+    pose.segment<3>(kRotationParam) = rotation;
     return unseen_fingers(input, pose).weight;
   };
   const auto facing = weights(Eigen::Vector3d::Zero());  // palm toward the camera, fingers up

@@ -46,6 +46,13 @@ TrackerConfig shipped_config() {
   return config;
 }
 
+// The same without E_unseen (w_u = 0).
+TrackerConfig without_unseen_fingers() {
+  TrackerConfig config = shipped_config();
+  config.weights.unseen_fingers = 0.0;
+  return config;
+}
+
 testing::OneHandRun track_view(const ViewCase& c, const PartForest& forest, uint64_t seed,
                                const TrackerConfig& config = shipped_config()) {
   synth::SynthOptions options;
@@ -182,8 +189,7 @@ TEST(FlatHandFromTheBack, MostFramesAreTheHandItIs) {
 // 26.4 mm with it, 30.2 mm without (better on five of the six sequences).
 TEST(FistsFromTheBack, FingersTheCameraCannotSeeCurl) {
   const PartForest forest = PartForest::load(shipped_forest_path().value());
-  TrackerConfig without = shipped_config();
-  without.weights.unseen_fingers = 0.0;
+  const TrackerConfig without = without_unseen_fingers();
   testing::OneHandRun with_prior;
   testing::OneHandRun without_prior;
   for (const char* motion : {"flexex1", "fingercount"}) {
@@ -208,8 +214,7 @@ TEST(FistsFromTheBack, NoCurlBesideAnotherHand) {
   options.view = synth::View::kBack;
   options.frames = 60;
   options.seed = kSeeds[0];
-  TrackerConfig without = shipped_config();
-  without.weights.unseen_fingers = 0.0;
+  const TrackerConfig without = without_unseen_fingers();
   Tracker beside_hand(shipped_config());
   Tracker alone(shipped_config());
   Tracker no_prior(without);

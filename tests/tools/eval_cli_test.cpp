@@ -62,14 +62,16 @@ class EvalCli : public ::testing::Test {
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   }
 
-  // Renders a one-hand synthetic sequence with ground-truth fingertips into dir_ / name.
-  fs::path render(const std::string& name, const handtrack::synth::SynthOptions& options) const {
+  // Renders a one-hand synthetic sequence into dir_ / name, with its ground-truth fingertips unless
+  // told otherwise.
+  fs::path render(const std::string& name, const handtrack::synth::SynthOptions& options,
+                  bool fingertips = true) const {
     handtrack::synth::SyntheticCamera cam(options);
     handtrack::SequenceWriter writer(dir_ / name, cam.camera());
     for (int f = 0; f < options.frames; ++f) {
       const auto frame = cam.render(f);
       writer.write_depth(f, frame.depth);
-      writer.write_fingertips(f, frame.fingertips);
+      if (fingertips) writer.write_fingertips(f, frame.fingertips);
     }
     writer.flush();
     return dir_ / name;
@@ -198,13 +200,7 @@ TEST_F(EvalCli, ARecordingAnnotatedOnlyWithItsHandIsScoredForHandedness) {
   o.motion = "pinch";
   o.hand = handtrack::synth::Handedness::kLeft;
   o.frames = 40;
-  handtrack::synth::SyntheticCamera cam(o);
-  const fs::path left = dir_ / "left";
-  {
-    handtrack::SequenceWriter writer(left, cam.camera());
-    for (int f = 0; f < o.frames; ++f) writer.write_depth(f, cam.render(f).depth);
-    writer.flush();
-  }
+  const fs::path left = render("left", o, false);
   std::ofstream(left / "hand.json") << nlohmann::json{{"hands", {"left"}}}.dump();
   const fs::path json = dir_ / "eval.json";
   std::string err;
