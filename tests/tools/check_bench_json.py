@@ -36,6 +36,16 @@ for name in TWO_HANDS:
         failures.append(f"{name}: {entry.get('hands_per_frame')!r} hands per frame")
     if not 0.5 <= entry.get("hand_overlap", 0) <= 2.05:
         failures.append(f"{name}: hand_overlap {entry.get('hand_overlap')!r}")
+# --only measures the configurations named and no other; an unknown name is one error line.
+subprocess.run([exe, "--frames", "10", "--only", "late_fusion_2p_10it", "--json", out], check=True,
+               stdout=subprocess.DEVNULL)
+with open(out) as f:
+    only = json.load(f)
+if sorted(only) != ["late_fusion_2p_10it"]:
+    failures.append(f"--only late_fusion_2p_10it measured {sorted(only)}")
+bad = subprocess.run([exe, "--only", "no_such_configuration"], capture_output=True, text=True)
+if bad.returncode == 0 or len(bad.stderr.strip().splitlines()) != 1 or "no_such_configuration" not in bad.stderr:
+    failures.append(f"--only no_such_configuration: exit {bad.returncode}, stderr {bad.stderr!r}")
 for f in failures:
     print("FAIL:", f)
 sys.exit(1 if failures else 0)

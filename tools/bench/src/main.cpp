@@ -73,18 +73,18 @@ int main(int argc, char** argv) {
   std::string motion = "random";
   std::string two_hand_motion = "two_apart";
   int frames = 300;
+  std::vector<std::string> only;
   app.add_option("--json", json_file, "write the table as JSON (SPEC.md)");
   app.add_option("--forest", forest_file, "part forest for the late-fusion configuration")->check(CLI::ExistingFile);
   app.add_option("--motion", motion, "synthetic motion to track");
   app.add_option("--two-hand-motion", two_hand_motion, "synthetic two-hand scene of the two-hand configurations");
   app.add_option("--frames", frames, "frames per configuration")->check(CLI::Range(10, 100000));
+  app.add_option("--only", only, "measure only these configurations (by name; default: all)");
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
 
   try {
     const PartForest forest = PartForest::load(forest_file);
     CameraIntrinsics camera;
-    const std::vector<DepthImage> one_hand = render(motion, frames, &camera);
-    const std::vector<DepthImage> two_hands = render(two_hand_motion, frames, &camera);
 
     const std::vector<BenchConfig> configs = {
         {"depth_only_1p_10it", EnergyMode::kDepthOnly, 1, 10},
@@ -99,12 +99,29 @@ int main(int argc, char** argv) {
         // The other latency setting: checks searched on a thread of their own, on idle CPU time.
         {"late_fusion_2p_10it_background_checks", EnergyMode::kLateFusion, 2, 10, 1, false, false, 0, true},
         {"two_hands_late_fusion_2p_10it_background_checks", EnergyMode::kLateFusion, 2, 10, 2, true, true, 0, true}};
+    for (const std::string& name : only) {
+      if (std::none_of(configs.begin(), configs.end(), [&](const BenchConfig& bc) { return bc.name == name; }))
+        throw std::runtime_error("--only: no configuration named '" + name + "'");
+    }
+    const auto measured = [&](const BenchConfig& bc) {
+      return only.empty() || std::find(only.begin(), only.end(), bc.name) != only.end();
+    };
+    // The frames of each scene that a measured configuration tracks, rendered before any timing.
+    const auto frames_of = [&](bool two_hand_scene, const std::string& scene) {
+      const bool tracked = std::any_of(configs.begin(), configs.end(), [&](const BenchConfig& bc) {
+        return measured(bc) && bc.two_hand_input == two_hand_scene;
+      });
+      return tracked ? render(scene, frames, &camera) : std::vector<DepthImage>{};
+    };
+    const std::vector<DepthImage> one_hand = frames_of(false, motion);
+    const std::vector<DepthImage> two_hands = frames_of(true, two_hand_motion);
     nlohmann::json out = nlohmann::json::object();
     tools::Progress progress(kProgram);
     std::printf("%-48s %8s %14s %12s %16s %8s\n", "configuration", "fps", "preprocess_ms", "optimize_ms",
                 "latency p50/p99", "overlap");
     for (size_t c = 0; c < configs.size(); ++c) {
       const auto& bc = configs[c];
+      if (!measured(bc)) continue;
       TrackerConfig tc;
       tc.mode = bc.mode;
       tc.particles = bc.particles;
