@@ -1,11 +1,14 @@
 #!/usr/bin/env python3
-"""Mirror grayscale PNGs left to right (8- or 16-bit, not interlaced), with the standard library.
+"""Grayscale PNGs (8- or 16-bit, not interlaced) mirrored or shifted, with the standard library.
 
-    mirror_png.py IN.png OUT.png
+    gray_png.py mirror IN.png OUT.png
+    gray_png.py shift DX DY IN.png OUT.png
 
-A depth frame mirrored so, with the principal point at cx' = (width - 1) - cx, shows a left hand
-where the frame showed a right one (docs/TRACKER.md, "Left hands"): what scripts/eval-real-still
-makes of the SR305's right hands.
+A depth frame mirrored left to right, with the principal point at cx' = (width - 1) - cx, shows a
+left hand where the frame showed a right one (docs/TRACKER.md, "Left hands"). Shifted by whole
+pixels (pixel (u, v) moves to (u + DX, v + DY), the uncovered border reads 0: no depth), with the
+principal point at (cx + DX, cy + DY), it shows the same scene on a pixel grid moved under it. What
+scripts/eval-real-still makes of the SR305's right hands.
 """
 import struct
 import sys
@@ -16,7 +19,7 @@ def read_gray(path):
     """Width, height, bytes per pixel and the unfiltered rows of a grayscale PNG."""
     data = open(path, "rb").read()
     if data[:8] != b"\x89PNG\r\n\x1a\n":
-        sys.exit(f"mirror_png: {path}: not a PNG")
+        sys.exit(f"gray_png: {path}: not a PNG")
     pos, idat, header = 8, b"", None
     while pos < len(data):
         (length,) = struct.unpack(">I", data[pos:pos + 4])
@@ -28,7 +31,7 @@ def read_gray(path):
         pos += 12 + length
     width, height, depth, colour, _, _, interlace = header
     if colour != 0 or depth not in (8, 16) or interlace != 0:
-        sys.exit(f"mirror_png: {path}: not an 8- or 16-bit grayscale, non-interlaced PNG")
+        sys.exit(f"gray_png: {path}: not an 8- or 16-bit grayscale, non-interlaced PNG")
     bpp = depth // 8
     stride = width * bpp
     raw = zlib.decompress(idat)
@@ -67,13 +70,37 @@ def write_gray(path, width, height, depth, rows):
         out.write(chunk(b"IEND", b""))
 
 
+def mirrored(width, bpp, rows):
+    return [b"".join(row[x * bpp:(x + 1) * bpp] for x in reversed(range(width))) for row in rows]
+
+
+def shifted(width, height, bpp, rows, dx, dy):
+    blank = bytes(width * bpp)
+    out = []
+    for v in range(height):
+        row = rows[v - dy] if 0 <= v - dy < height else blank
+        if dx >= 0:
+            row = bytes(min(dx, width) * bpp) + row[:max(0, width - dx) * bpp]
+        else:
+            row = row[min(-dx, width) * bpp:] + bytes(min(-dx, width) * bpp)
+        out.append(row)
+    return out
+
+
 def main():
-    if len(sys.argv) != 3:
-        sys.exit("usage: mirror_png.py IN.png OUT.png")
-    width, height, depth, rows = read_gray(sys.argv[1])
-    bpp = depth // 8
-    mirrored = [b"".join(row[x * bpp:(x + 1) * bpp] for x in reversed(range(width))) for row in rows]
-    write_gray(sys.argv[2], width, height, depth, mirrored)
+    args = sys.argv[1:]
+    if len(args) == 3 and args[0] == "mirror":
+        width, height, depth, rows = read_gray(args[1])
+        write_gray(args[2], width, height, depth, mirrored(width, depth // 8, rows))
+    elif len(args) == 5 and args[0] == "shift":
+        try:
+            dx, dy = int(args[1]), int(args[2])
+        except ValueError:
+            sys.exit(f"gray_png: shift: DX and DY must be whole pixels, got {args[1]!r} {args[2]!r}")
+        width, height, depth, rows = read_gray(args[3])
+        write_gray(args[4], width, height, depth, shifted(width, height, depth // 8, rows, dx, dy))
+    else:
+        sys.exit("usage: gray_png.py mirror IN.png OUT.png | gray_png.py shift DX DY IN.png OUT.png")
 
 
 if __name__ == "__main__":
