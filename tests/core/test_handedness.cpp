@@ -5,10 +5,12 @@
 //   each other, each reported as its own hand.
 // - Real SR305 frames (right hands; ../shared/data, skipped where absent): the same frame mirrored
 //   left to right (image and cx) always fits as the other hand, with fingertips that are the
-//   mirror of the first fit's; and most frames fit as the right hand they are. Not all: in
-//   230536/170 the palm-facing right hand explains slightly more of the depth as a left hand seen
-//   from the back (a model of isotropic Gaussians is nearly the same seen from either side), the
-//   failure the issue "Every hand, every view" still has to remove.
+//   mirror of the first fit's; and most frames fit as the right hand they are, also held still
+//   (shown trembling by a pixel). Not all: a palm-facing right hand explains about as much of the
+//   depth as a left hand seen from the back (a model of isotropic Gaussians is nearly the same seen
+//   from either side), and the forest, trained on renders, labels real fingers poorly, so which
+//   hand a real frame ends as turns even on the alignment of the pixel grid: the failure the issue
+//   "Every hand, every view" still has to remove.
 #include "handtrack/core/hands_tracker.hpp"
 #include "handtrack/core/part_forest.hpp"
 #include "handtrack/core/png_io.hpp"
@@ -20,6 +22,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -156,19 +159,45 @@ INSTANTIATE_TEST_SUITE_P(DepthOnlyAndShipped, RealHands,
                            return std::string(c.param.mode == EnergyMode::kLateFusion ? "late_fusion" : "depth_only");
                          });
 
-// Each SR305 frame shown kStillShown times in a row to a fresh tracker (`shown(depth)`: the hand
-// it reports at the end, nullopt for none): how many frames had a hand in the working volume, and
-// how many of them were the right hand at the end. The others are printed.
+// Each SR305 frame shown kStillShown times in a row to a fresh tracker (`shown(frames)`: the hand
+// it reports at the end of the frames, nullopt for none): how many frames had a hand in the
+// working volume, and how many of them were the right hand at the end. The others are printed.
+//
+// Shown trembling: frame k is the recorded image moved by (0, 0), (1, 0), (1, 1) or (0, 1) pixels
+// in turn, the camera unchanged, a hand that moves by a pixel (about 1.5 mm at 700 mm) from frame
+// to frame, as a real hand held still does. The same image shown unchanged 31 times turns on the
+// alignment of the pixel grid alone: moved by one pixel with the principal point moved with it
+// (the same scene in 3D), the share of these frames reported right went from 90 % to 60-84 %
+// (scripts/eval-real-still, docs/TRACKER.md "Real frames"), so a bound on the unchanged image
+// asserts one lucky alignment.
 constexpr int kStillShown = 31;
 struct StillFrames {
   int frames = 0;
   int right = 0;
 };
+
+// `depth` moved by (dx, dy) >= 0 pixels; the uncovered border has no depth.
+DepthImage moved(const DepthImage& depth, int dx, int dy) {
+  DepthImage out = depth;
+  std::fill(out.depth_mm.begin(), out.depth_mm.end(), 0.0F);
+  for (int v = dy; v < depth.height(); ++v) {
+    for (int u = dx; u < depth.width(); ++u) out.at(u, v) = depth.at(u - dx, v - dy);
+  }
+  return out;
+}
+
+std::vector<DepthImage> trembling(const DepthImage& depth) {
+  const std::array<DepthImage, 4> aligned = {depth, moved(depth, 1, 0), moved(depth, 1, 1), moved(depth, 0, 1)};
+  std::vector<DepthImage> frames;
+  for (int k = 0; k < kStillShown; ++k) frames.push_back(aligned[static_cast<size_t>(k % 4)]);
+  return frames;
+}
+
 template <typename Shown>
 StillFrames still_frames(const std::vector<fs::path>& files, Shown&& shown) {
   StillFrames count;
   for (const fs::path& file : files) {
-    const std::optional<Handedness> hand = shown(read_sr305_frame(file));
+    const std::optional<Handedness> hand = shown(trembling(read_sr305_frame(file)));
     if (!hand) continue;  // beyond the working volume
     ++count.frames;
     count.right += *hand == Handedness::kRight ? 1 : 0;
@@ -177,52 +206,48 @@ StillFrames still_frames(const std::vector<fs::path>& files, Shown&& shown) {
   return count;
 }
 
-// A real hand held still: each SR305 frame shown 31 times in a row to one tracker (a (re)start,
-// its handedness trial, then tracking, with the trials again of a mediocre fit) is still reported
-// as the right hand it is at the end, in the shipped configuration. What it guards is the tracked
-// fit's own energy: the (re)start and its trial chose the right hand on all 17 frames, but with
-// E_sim as in eq. 6 while tracking (no coverage cap) the tracked fits of 230536/30, 230536/150 and
-// 231615/60 turned to the left hand within the 30 frames; with the shipped cap none did
-// (docs/TRACKER.md, "E_sim's coverage cap"). It guards the search's w_c too: with the tracking w_c
-// of 0.5 in the (re)start search as well, 13 of 17 stayed right (docs/TRACKER.md, "w_c while
-// tracking"). The bound: at most one frame in 12 turned.
+// A real hand held still: each SR305 frame shown trembling to one tracker (a (re)start, its
+// handedness trial, then tracking, with the trials again of a mediocre fit) is still reported as
+// the right hand it is at the end, in the shipped configuration. Measured (2026-11-28, seed 1): 15
+// of the 19 frames (230536/130, 150, 170 and 231615/180 left), with the coverage cap and without
+// it alike. (On the unchanged image, 17 of 17 with the cap and 14 of 17 without, but that
+// alignment's luck: docs/TRACKER.md, "Real frames".) The bound: 3 of 4.
 TEST(RealStillHand, StaysTheRightHandWhileTracked) {
   const std::vector<fs::path> files = sr305_frames();
   if (files.empty()) GTEST_SKIP() << "shared data absent: " << kSr305Root;
   const PartForest forest = PartForest::load(shipped_forest_path().value());
-  const StillFrames still = still_frames(files, [&](const DepthImage& depth) -> std::optional<Handedness> {
+  const StillFrames still = still_frames(files, [&](const std::vector<DepthImage>& frames) -> std::optional<Handedness> {
     Tracker tracker(sr305_config(EnergyMode::kLateFusion));
     TrackerOutput out;
-    for (int k = 0; k < kStillShown; ++k) out = tracker.track(depth, &forest);
+    for (const DepthImage& depth : frames) out = tracker.track(depth, &forest);
     if (out.state == TrackingState::kNoHand) return std::nullopt;
     return out.handedness;
   });
   EXPECT_GE(still.frames, 6) << "frames with a hand in the working volume";
-  EXPECT_GE(12 * still.right, 11 * still.frames) << still.right << " of " << still.frames
-                                                 << " still frames stayed a right hand";
+  EXPECT_GE(4 * still.right, 3 * still.frames) << still.right << " of " << still.frames
+                                               << " still frames stayed a right hand";
 }
 
 // The same still frames as handtrackd tracks them: HandsTracker with room for one hand (the frame
-// shared out first), the last of 31 shown frames. Measured (2026-11-28): 17 of the 19 frames with
-// a hand right at seed 1, 15-16 at seeds 2-4. 231615/20 is a left hand at every seed: the forest
-// labels its thumb a little finger, and the fit is a left hand's palm with the thumb on the wrong
-// side (docs/TRACKER.md, "Real frames"); 230536/170 (hand, arm and torso one surface) goes either
-// way. The issue's goal, every frame right, is not met on this path; the bound guards what is.
+// shared out first), the last of the trembling frames. Measured (2026-11-28, seed 1): 15 of 19
+// (230536/150, 170 and 231615/20, 200 left; 231615/20's thumb is labelled a little finger, and in
+// 230536/170 and 231615/200 the hand, arm and body are near one another). The issue's goal, every
+// frame right, is not met; the bound (3 of 4) guards what is.
 TEST(RealStillHand, MostStayTheRightHandAsHandtrackdTracksThem) {
   const std::vector<fs::path> files = sr305_frames();
   if (files.empty()) GTEST_SKIP() << "shared data absent: " << kSr305Root;
   const PartForest forest = PartForest::load(shipped_forest_path().value());
   TrackerConfig config = sr305_config(EnergyMode::kLateFusion);
   config.max_hands = 1;
-  const StillFrames still = still_frames(files, [&](const DepthImage& depth) -> std::optional<Handedness> {
+  const StillFrames still = still_frames(files, [&](const std::vector<DepthImage>& frames) -> std::optional<Handedness> {
     HandsTracker tracker(config);
     HandsOutput out;
-    for (int k = 0; k < kStillShown; ++k) out = tracker.track(depth, &forest);
+    for (const DepthImage& depth : frames) out = tracker.track(depth, &forest);
     if (out.count == 0) return std::nullopt;
     return out.hands[0].handedness;
   });
   EXPECT_GE(still.frames, 15) << "frames with a hand in the working volume";
-  EXPECT_GE(6 * still.right, 5 * still.frames) << still.right << " of " << still.frames
+  EXPECT_GE(4 * still.right, 3 * still.frames) << still.right << " of " << still.frames
                                                << " still frames reported as the right hand";
 }
 
