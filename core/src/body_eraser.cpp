@@ -35,17 +35,7 @@ bool BodyEraser::find(const DepthInputConfig& config, const CameraIntrinsics& ca
     any = any || candidate_[c] != 0;
   }
   if (!any) return false;
-  // Room for the largest box (the whole image and its ring) the first time: a rare frame finds a
-  // body, and a larger one than before must not allocate (the daemon's steady state).
-  const auto most_cells = static_cast<size_t>(w + 2) * static_cast<size_t>(h + 2);
-  if (grid_.capacity() < most_cells) {
-    grid_.reserve(most_cells);
-    pixel_.reserve(most_cells);
-    mine_.reserve(most_cells);
-    stack_.reserve(most_cells);  // flood4 pushes a cell once
-    opening_.reserve(most_cells);
-    part_.reserve(most_cells);
-  }
+  reserve(w, h);  // nothing where the owner did (on its first frame)
   boxes_.assign(surfaces.size(), PixelBox{w, h, -1, -1});
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
@@ -57,6 +47,18 @@ bool BodyEraser::find(const DepthInputConfig& config, const CameraIntrinsics& ca
     if (candidate_[c] != 0) add_opening(camera, radius_mm, depth_mm, component, static_cast<int>(c), boxes_[c]);
   }
   return !opening_.empty();
+}
+
+void BodyEraser::reserve(int width, int height) {
+  // The largest box: the whole image and its ring.
+  const auto most_cells = static_cast<size_t>(std::max(width, 0) + 2) * static_cast<size_t>(std::max(height, 0) + 2);
+  if (grid_.capacity() >= most_cells) return;
+  grid_.reserve(most_cells);
+  pixel_.reserve(most_cells);
+  mine_.reserve(most_cells);
+  stack_.reserve(most_cells);  // flood4 pushes a cell once
+  opening_.reserve(most_cells);
+  part_.reserve(most_cells);
 }
 
 void BodyEraser::erase(std::vector<float>& depth_mm) const {

@@ -43,6 +43,10 @@ class BodyEraser {
   bool find(const DepthInputConfig& config, const CameraIntrinsics& camera, const std::vector<float>& depth_mm,
             const std::vector<int>& component, const std::vector<Surface>& surfaces,
             const std::vector<uint8_t>* eligible = nullptr);
+  // Room for an image of width x height (the whole image and its ring), so that find() never
+  // allocates: its owner calls this on its first frame, since a body may first come into the
+  // working volume long after start-up (the daemon's steady state allocates nothing).
+  void reserve(int width, int height);
   // Sets the pixels of the openings find() found last to 0 (an image of the camera find() was
   // given); the caller labels the surfaces again.
   void erase(std::vector<float>& depth_mm) const;

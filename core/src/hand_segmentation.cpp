@@ -69,6 +69,7 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
   component_.resize(n);
   blobs_.reserve(n);
   stack_.reserve(n);
+  body_.reserve(w, h);
   // The frame shared out among hands: this slot's pixels are those not foreign.
   const bool shared_out = foreign != nullptr && foreign->size() == n;
   if (shared_out) {

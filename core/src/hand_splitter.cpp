@@ -170,6 +170,7 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
   // Every slot's mask sized on the first frame, not on the first frame that needs it (a pipeline
   // frame's first second hand may come long after start-up).
   for (auto& mask : foreign) mask.resize(n);
+  body_.reserve(w, h);  // and the body eraser's room, though a body may come later
   // The surfaces of the median-filtered working volume (as HandSegmenter sees them: flying pixels
   // between two hands would otherwise join them).
   const std::vector<float>& median = median_.apply(depth, config.median_radius_px);

@@ -46,11 +46,11 @@ void QuadtreeBuilder::build(const DepthInputConfig& config, const PixelBox& box,
     }
   }
   for (int y = cells_.y0; y <= box.v1; y += root) {
-    for (int x = cells_.x0; x <= box.u1; x += root) quad(x, y, root);
+    for (int x = cells_.x0; x <= box.u1; x += root) quad(x, y, root, true);
   }
 }
 
-void QuadtreeBuilder::quad(int x, int y, int side) {
+void QuadtreeBuilder::quad(int x, int y, int side, bool split_partial) {
   const int w = out_->camera.width;
   const int h = out_->camera.height;
   const int xe = std::min(x + side, w);
@@ -67,12 +67,14 @@ void QuadtreeBuilder::quad(int x, int y, int side) {
   const int area = (xe - x) * (ye - y);
   const bool full_enough = count >= config_->min_leaf_fill * area;
   const bool flat = node.hi - node.lo < config_->quadtree_threshold_mm;
-  if (side > cells_.side && !(flat && full_enough)) {
+  const bool leaf = flat && full_enough;
+  const bool partial = count < config_->split_partial_leaf_fill * area;
+  if (side > cells_.side && (!leaf || (split_partial && partial))) {
     const int half = side / 2;
-    quad(x, y, half);
-    quad(x + half, y, half);
-    quad(x, y + half, half);
-    quad(x + half, y + half, half);
+    quad(x, y, half, !leaf);
+    quad(x + half, y, half, !leaf);
+    quad(x, y + half, half, !leaf);
+    quad(x + half, y + half, half, !leaf);
     return;
   }
   if (!full_enough) return;

@@ -2,7 +2,11 @@
 // The quadtree over the segmented hand (paper Sec. 3.1): cells are split until the depth range of
 // their hand pixels is below epsilon_c; every leaf full enough of hand pixels becomes a unit-weight
 // 2D Gaussian with sigma = a / sqrt(2) and the mean depth of its pixels, labelled by the majority
-// part label of its pixels (Sec. 4.3). Private to core (DepthInputBuilder).
+// part label of its pixels (Sec. 4.3). Ours: a leaf that the hand's outline crosses (less full than
+// split_partial_leaf_fill) is split once more, so that its Gaussian, at the cell's centre, does not
+// sit up to a quarter of the cell off the finger it half covers. Once only: split down to the
+// smallest cell, a real sensor's ragged outline becomes hundreds of 2 px leaves. Private to core
+// (DepthInputBuilder).
 #include "hand_segmentation.hpp"
 
 #include "handtrack/core/depth_input.hpp"
@@ -19,7 +23,9 @@ class QuadtreeBuilder {
   void build(const DepthInputConfig& config, const PixelBox& box, DepthInput& out);
 
  private:
-  void quad(int x, int y, int side);
+  // The cell of `side` px at (x, y); `split_partial`: whether a partial leaf may still be split
+  // (false in the quarters of one that was).
+  void quad(int x, int y, int side, bool split_partial);
 
   // The hand's depths per smallest quadtree cell.
   struct CellStats {

@@ -199,6 +199,8 @@ const std::vector<Field>& fields() {
      "smallest quadtree cell at 320 px width", true},
     {"tracker.input.min_leaf_fill", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.input.min_leaf_fill; }}, 0, 1,
      "fraction of hand pixels a leaf needs", true},
+    {"tracker.input.split_partial_leaf_fill", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.input.split_partial_leaf_fill; }}, 0, 1,
+     "a leaf less full of hand pixels than this is split once more (0: never)", true},
     {"tracker.input.continuity_mm", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.input.continuity_mm; }}, 0.1, 1000,
      "neighbouring pixels closer than this are one surface (segmentation)", true},
     {"tracker.input.min_hand_area_mm2", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.input.min_hand_area_mm2; }}, 0, 1e6,

@@ -120,8 +120,11 @@ TEST(DepthInput, SteepSurfacesSplitFinerThanFlatOnes) {
   }
   // A hint that keeps both squares whole: centred on them, the wrist plane far below.
   const HandHint hint{cam.unproject(160, 120, 480), cam.unproject(160, 400, 480), Eigen::Vector3d(0, -1, 0)};
-  DepthInputBuilder a;
-  DepthInputBuilder b;
+  // epsilon_c alone (Sec. 3.1): the leaves that the squares' outline crosses not split once more.
+  DepthInputConfig config;
+  config.split_partial_leaf_fill = 0.0;
+  DepthInputBuilder a(config);
+  DepthInputBuilder b(config);
   const auto& in_flat = a.build(flat, hint);
   const auto& in_steep = b.build(steep, hint);
   EXPECT_GE(in_flat.hand_pixels, 80 * 80 - 4);  // the 3x3 median takes the four corners
@@ -130,6 +133,38 @@ TEST(DepthInput, SteepSurfacesSplitFinerThanFlatOnes) {
   const size_t n_steep = in_steep.gaussians.size();
   EXPECT_LT(n_flat, n_steep / 4);
   expect_leaf_properties(b.last(), b.config());
+}
+
+// A leaf that the hand's outline crosses is split once more (DepthInputConfig::
+// split_partial_leaf_fill), so that no leaf's square hangs far over the outline: a flat square
+// whose left and right edges cross the middle of 16 px cells. Kept whole, those cells are half
+// full, leaves (min_leaf_fill 0.5) whose Gaussians sit on the outline, half their side beyond it;
+// split once, their outer halves are empty and leave, their inner halves are full leaves.
+TEST(DepthInput, ALeafTheOutlineCrossesIsSplitOnce) {
+  const auto cam = camera(320, 240);
+  DepthImage square{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 0.0F)};
+  for (int v = 80; v < 160; ++v) {
+    for (int u = 120; u < 200; ++u) square.at(u, v) = 400.0F;
+  }
+  const HandHint hint{cam.unproject(160, 120, 480), cam.unproject(160, 400, 480), Eigen::Vector3d(0, -1, 0)};
+  // How far the leaves hang over the square's outline, the most of any, in leaf sides.
+  const auto overhang = [&](double split_fill) {
+    DepthInputConfig config;
+    config.split_partial_leaf_fill = split_fill;
+    DepthInputBuilder builder(config);
+    const DepthInput& in = builder.build(square, hint);
+    EXPECT_GE(in.hand_pixels, 80 * 80 - 4);
+    double most = 0.0;
+    for (const ImageGaussian& g : in.gaussians) {
+      const double u0 = g.u + 0.5 - 0.5 * g.side_px;  // the leaf's pixels: [u0, u0 + side)
+      const double v0 = g.v + 0.5 - 0.5 * g.side_px;
+      const double over = std::max({120.0 - u0, u0 + g.side_px - 200.0, 80.0 - v0, v0 + g.side_px - 160.0, 0.0});
+      most = std::max(most, over / g.side_px);
+    }
+    return most;
+  };
+  EXPECT_GE(overhang(0.0), 0.5) << "without the split, half-full leaves hang half over the outline";
+  EXPECT_LE(overhang(DepthInputConfig{}.split_partial_leaf_fill), 0.0) << "split once, none does";
 }
 
 TEST(DepthInput, NothingInsideTheWorkingVolumeMeansNoHand) {

@@ -259,7 +259,10 @@ TEST(RealStillHand, MostStayTheRightHandAsHandtrackdTracksThem) {
 // without (docs/TRACKER.md, "A mediocre fit is tried as the other hand again"). With the paper's
 // w_s: since w_s = 0.1 became the default, the first trial chooses the right hand on this scene,
 // and on all 30 fingercount scenes of seeds 1-3 (five views, both hands) as well (docs/TRACKER.md,
-// "w_s, the weight of E_smo").
+// "w_s, the weight of E_smo"). The subject: seed 1 since the forest of 15,000 images and the
+// once-split partial leaves (2026-11-28), with which seed 2's first trial chooses right; of
+// fingercount seen fingers toward, seeds 1-4, seed 1 (both hands) and seed 2's left hand still
+// choose wrong, and the back view's seeds 1-4 none.
 TEST(HandednessRetrial, AHandChosenWrongOnAFistIsTriedAgain) {
   const PartForest forest = PartForest::load(shipped_forest_path().value());
   synth::SynthOptions options;
@@ -267,7 +270,7 @@ TEST(HandednessRetrial, AHandChosenWrongOnAFistIsTriedAgain) {
   options.view = synth::View::kFingersToward;
   options.hand = synth::Handedness::kRight;
   options.frames = 300;
-  options.seed = 2;
+  options.seed = 1;
   TrackerConfig config;
   config.mode = EnergyMode::kLateFusion;
   config.weights.smoothness = kPapersSmoothness;

@@ -35,6 +35,9 @@ struct DepthInputConfig {
   int quadtree_root_px = 32;            // root cell side at 320 px image width (scales with width)
   int quadtree_min_leaf_px = 2;         // smallest cell at 320 px width (scales with width)
   double min_leaf_fill = 0.5;           // a leaf must be at least this full of hand pixels
+  // Ours: a leaf less full than this (a cell the hand's outline crosses) is split once more, its
+  // quarters kept where at least min_leaf_fill full; 0: never (docs/TRACKER.md, "Real frames").
+  double split_partial_leaf_fill = 0.8;
   double continuity_mm = 25.0;          // neighbouring pixels closer than this are one surface
   double min_hand_area_mm2 = 1500.0;    // smaller blobs are noise, not a hand
   double hand_length_mm = 190.0;        // wrist to middle fingertip, bounds the hand region
