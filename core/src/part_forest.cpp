@@ -372,7 +372,8 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
 
   // The hand's bounding box, copied with the background constant off the mask: probes then need
   // one bounds check, and the crop is small enough to stay in cache. Storage is per thread and
-  // reused (no allocation once it has grown).
+  // reused, with room for the whole image from a thread's first frame: a hand's box larger than
+  // any before must not allocate (the daemon's steady state).
   int x0 = w, y0 = h, x1 = -1, y1 = -1;
   for (int y = 0; y < h; ++y) {
     const uint8_t* row = mask + at(0, y);
@@ -387,8 +388,9 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
       y1 = std::max(y1, y);
     }
   }
-  if (x1 < 0) return;
   thread_local std::vector<float> crop_storage;
+  if (crop_storage.capacity() < n) crop_storage.reserve(n);
+  if (x1 < 0) return;
   Crop crop;
   crop.x0 = x0;
   crop.y0 = y0;
