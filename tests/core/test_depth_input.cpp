@@ -108,18 +108,26 @@ TEST(DepthInput, SelfSimilarityEqualsTheFullPairSum) {
   }
 }
 
+// An 80 x 80 px square at pixels [120, 200) x [80, 160), 400 mm deep at its left edge and
+// `mm_per_px` deeper each pixel to the right, nothing else in view.
+DepthImage square_scene(const CameraIntrinsics& cam, double mm_per_px) {
+  DepthImage depth{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 0.0F)};
+  for (int v = 80; v < 160; ++v) {
+    for (int u = 120; u < 200; ++u) depth.at(u, v) = static_cast<float>(400 + mm_per_px * (u - 120));
+  }
+  return depth;
+}
+
+// A hint that keeps square_scene()'s square whole: centred on it, the wrist plane far below.
+HandHint square_hint(const CameraIntrinsics& cam) {
+  return {cam.unproject(160, 120, 480), cam.unproject(160, 400, 480), Eigen::Vector3d(0, -1, 0)};
+}
+
 TEST(DepthInput, SteepSurfacesSplitFinerThanFlatOnes) {
   const auto cam = camera(320, 240);
-  DepthImage flat{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 0.0F)};
-  DepthImage steep = flat;
-  for (int v = 80; v < 160; ++v) {
-    for (int u = 120; u < 200; ++u) {
-      flat.at(u, v) = 400.0F;
-      steep.at(u, v) = static_cast<float>(400 + 2.0 * (u - 120));  // 2 mm per pixel
-    }
-  }
-  // A hint that keeps both squares whole: centred on them, the wrist plane far below.
-  const HandHint hint{cam.unproject(160, 120, 480), cam.unproject(160, 400, 480), Eigen::Vector3d(0, -1, 0)};
+  const DepthImage flat = square_scene(cam, 0.0);
+  const DepthImage steep = square_scene(cam, 2.0);
+  const HandHint hint = square_hint(cam);
   // epsilon_c alone (Sec. 3.1): the leaves that the squares' outline crosses not split once more.
   DepthInputConfig config;
   config.split_partial_leaf_fill = 0.0;
@@ -142,11 +150,8 @@ TEST(DepthInput, SteepSurfacesSplitFinerThanFlatOnes) {
 // split once, their outer halves are empty and leave, their inner halves are full leaves.
 TEST(DepthInput, ALeafTheOutlineCrossesIsSplitOnce) {
   const auto cam = camera(320, 240);
-  DepthImage square{cam, std::vector<float>(static_cast<size_t>(cam.width) * cam.height, 0.0F)};
-  for (int v = 80; v < 160; ++v) {
-    for (int u = 120; u < 200; ++u) square.at(u, v) = 400.0F;
-  }
-  const HandHint hint{cam.unproject(160, 120, 480), cam.unproject(160, 400, 480), Eigen::Vector3d(0, -1, 0)};
+  const DepthImage square = square_scene(cam, 0.0);
+  const HandHint hint = square_hint(cam);
   // How far the leaves hang over the square's outline, the most of any, in leaf sides.
   const auto overhang = [&](double split_fill) {
     DepthInputConfig config;
