@@ -154,9 +154,15 @@ void Tracker::reset() {
 
 InputRequest Tracker::request() const {
   const bool all = both();
+  // In a trial, a hand that optimise() will not fit on this frame (lost, no (re)start due) gets no
+  // input: with checks off the frame, a hand whose start found nothing cost a second hand's
+  // preprocessing on each of the trial's frames (docs/BENCHMARKS.md). Both skipped (not seen: a
+  // new trial restarts both) asks for both, as before.
+  const bool skip_right = all && trial_skips(Handedness::kRight);
+  const bool skip_left = all && trial_skips(Handedness::kLeft);
   InputRequest r;
-  r.right = all || current_ == Handedness::kRight;
-  r.left = all || current_ == Handedness::kLeft;
+  r.right = all ? !skip_right || skip_left : current_ == Handedness::kRight;
+  r.left = all ? !skip_left || skip_right : current_ == Handedness::kLeft;
   if (r.right) r.right_hint = right_.hint();
   if (r.left) r.left_hint = left_.hint();
   return r;
@@ -221,6 +227,12 @@ bool Tracker::both() const {
   return config().handedness == HandednessMode::kAuto && (trial_pending_ || trial_frames_ > 0);
 }
 
+bool Tracker::trial_restarts() const {
+  return trial_frames_ == 0 || (!checks_off_the_frame(config()) && trial_frames_ % kTrialRestartFrames == 0);
+}
+
+bool Tracker::trial_skips(Handedness hand) const { return side(hand).lost() && !trial_restarts(); }
+
 void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left) {
   // A hand seen on one frame can be either: a fist, a hand edge-on, or a flat hand whose palm or
   // back faces the camera (a right hand's palm and a left hand's back are mirror images through the
@@ -279,7 +291,14 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
   const DepthInput* right = inputs.get(Handedness::kRight);
   const DepthInput* left = inputs.get(Handedness::kLeft);
   TrackerOutput out;
-  if (right != nullptr && left != nullptr && both()) {
+  // A trial's frame needs the input of each hand it fits (trial_skips: request() asked for no
+  // other). One without (a pipelined frame preprocessed before the trial asked for it) is fitted as
+  // outside a trial, and the trial waits for the next frame.
+  const auto trial_ready = [&](Handedness hand, const DepthInput* input) {
+    return input != nullptr || trial_skips(hand);
+  };
+  if (both() && (right != nullptr || left != nullptr) && trial_ready(Handedness::kRight, right) &&
+      trial_ready(Handedness::kLeft, left)) {
     // A trial: both hands, each from its history or its (re)start hypotheses; each hand's
     // suspect-fit checks go at the configured pace, as when it tracks alone. A hand lost later in
     // the trial scores 0 and is (re)started again every kTrialRestartFrames frames, a whole search
@@ -287,13 +306,11 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
     // latency settings: no tracked frame runs a whole search), where it is not. Never (re)started,
     // the true hand that found no start on a fist was lost for good: fingercount 37.2 -> 45.1 mm,
     // handedness 77 -> 60 %.
-    const bool restarts =
-        trial_frames_ == 0 || (!checks_off_the_frame(config()) && trial_frames_ % kTrialRestartFrames == 0);
-    const auto trial_fit = [&](Handedness hand, const DepthInput& input) {
-      return side(hand).lost() && !restarts ? TrackerOutput{} : fit(hand, input);
+    const auto trial_fit = [&](Handedness hand, const DepthInput* input) {
+      return trial_skips(hand) ? TrackerOutput{} : fit(hand, *input);
     };
-    const TrackerOutput as_right = trial_fit(Handedness::kRight, *right);
-    const TrackerOutput as_left = trial_fit(Handedness::kLeft, *left);
+    const TrackerOutput as_right = trial_fit(Handedness::kRight, right);
+    const TrackerOutput as_left = trial_fit(Handedness::kLeft, left);
     weigh(as_right, as_left);
     out = current_ == Handedness::kLeft ? as_left : as_right;
     // A hand that found no fit is not reported over one that did.

@@ -403,6 +403,12 @@ class Tracker {
   PoseTracker& side(Handedness hand) { return hand == Handedness::kLeft ? left_ : right_; }
   // Both hands this frame: a trial under way or due.
   [[nodiscard]] bool both() const;
+  // This frame of a trial (re)starts a lost hand: its first frame, and every kTrialRestartFrames
+  // frames unless checks are off the frame (spread or in the background).
+  [[nodiscard]] bool trial_restarts() const;
+  // A hand the trial does not fit on this frame (lost, and no (re)start due): request() does not
+  // ask for its input.
+  [[nodiscard]] bool trial_skips(Handedness hand) const;
   // One frame of a handedness trial: the evidence from both hands' fits, the hand it favours
   // (current_), and the trial's end.
   void weigh(const TrackerOutput& as_right, const TrackerOutput& as_left);
