@@ -45,8 +45,35 @@ ImageMixtureSlice ImageMixture::Columns::slice(std::size_t begin, std::size_t en
   const double* lo = partition_point(depth_mm.data() + begin, end - begin, [&](double d) { return d < lo_mm; });
   const double* hi = partition_point(lo, static_cast<std::size_t>(depth_mm.data() + end - lo),
                                      [&](double d) { return d <= hi_mm; });
-  const auto i = static_cast<std::size_t>(lo - depth_mm.data());
-  return {u.data() + i, v.data() + i, sigma2.data() + i, depth_mm.data() + i, static_cast<std::size_t>(hi - lo), i};
+  return span(static_cast<std::size_t>(lo - depth_mm.data()), static_cast<std::size_t>(hi - depth_mm.data()));
+}
+
+ImageMixtureSlice ImageMixture::Columns::span(std::size_t first, std::size_t last) const {
+  return {u.data() + first, v.data() + first, sigma2.data() + first, depth_mm.data() + first, last - first, first};
+}
+
+void ImageMixture::DepthIndex::build(const std::vector<double>& sorted_depth_mm) {
+  const std::size_t n = sorted_depth_mm.size();
+  first.resize(n + 1);
+  if (n == 0) {
+    first[0] = 0;
+    return;
+  }
+  origin_mm = sorted_depth_mm.front();
+  const double range_mm = sorted_depth_mm.back() - origin_mm;
+  inv_width = range_mm > 0.0 ? static_cast<double>(n) / range_mm : 1.0;
+  std::size_t k = 0;
+  for (std::size_t b = 0; b <= n; ++b) {
+    while (k < n && bucket(sorted_depth_mm[k]) < b) ++k;
+    first[b] = k;
+  }
+}
+
+std::size_t ImageMixture::DepthIndex::bucket(double depth_mm) const {
+  const double x = (depth_mm - origin_mm) * inv_width;
+  const auto last = static_cast<double>(first.size() - 2);
+  // Clamped in double before the conversion (any x, an infinity too, converts within range).
+  return x > 0.0 ? static_cast<std::size_t>(std::min(x, last)) : 0;
 }
 
 void ImageMixture::Columns::reserve(std::size_t n) {
@@ -58,6 +85,7 @@ void ImageMixture::Columns::reserve(std::size_t n) {
 
 void ImageMixture::reserve(std::size_t n) {
   by_depth_.reserve(n);
+  depth_index_.first.reserve(n + 1);
   by_label_.reserve(n);
   order_.reserve(n);
   covered_.reserve(n);
@@ -77,6 +105,7 @@ void ImageMixture::assign(const std::vector<ImageGaussian>& gaussians) {
   const auto depth = [&](std::size_t i) { return gaussians[i].depth_mm; };
   std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return depth(a) < depth(b); });
   for (std::size_t k = 0; k < n; ++k) by_depth_.set(k, gaussians[order_[k]]);
+  depth_index_.build(by_depth_.depth_mm);
 
   // By label, then depth (std::sort: no allocation, unlike std::stable_sort).
   std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) {
@@ -101,7 +130,17 @@ double* ImageMixture::pair_scratch(std::size_t values) const {
 }
 
 ImageMixtureSlice ImageMixture::depth_slice(double lo_mm, double hi_mm) const {
-  return by_depth_.slice(0, size(), lo_mm, hi_mm);
+  if (size() == 0) return by_depth_.span(0, 0);
+  // Each bound searched within its own bucket (DepthIndex): the same Gaussians as a search of all.
+  const double* depth = by_depth_.depth_mm.data();
+  const std::vector<std::size_t>& first = depth_index_.first;
+  const std::size_t b_lo = depth_index_.bucket(lo_mm);
+  const std::size_t b_hi = depth_index_.bucket(hi_mm);
+  const double* lo = partition_point(depth + first[b_lo], first[b_lo + 1] - first[b_lo],
+                                     [&](double d) { return d < lo_mm; });
+  const double* hi = partition_point(depth + first[b_hi], first[b_hi + 1] - first[b_hi],
+                                     [&](double d) { return d <= hi_mm; });
+  return by_depth_.span(static_cast<std::size_t>(lo - depth), static_cast<std::size_t>(std::max(lo, hi) - depth));
 }
 
 ImageMixtureSlice ImageMixture::label_slice(int label, double lo_mm, double hi_mm) const {

@@ -9,5 +9,5 @@
 #if defined(HANDTRACK_NO_TARGET_CLONES)
 #define HANDTRACK_TARGET_CLONES
 #else
-#define HANDTRACK_TARGET_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#define HANDTRACK_TARGET_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #endif

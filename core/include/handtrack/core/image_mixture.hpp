@@ -67,8 +67,23 @@ class ImageMixture {
     void set(std::size_t i, const ImageGaussian& g);
     // [begin, end) narrowed to lo_mm <= d_q <= hi_mm (the range is ordered by depth).
     [[nodiscard]] ImageMixtureSlice slice(std::size_t begin, std::size_t end, double lo_mm, double hi_mm) const;
+    // Gaussians [first, last) as a slice.
+    [[nodiscard]] ImageMixtureSlice span(std::size_t first, std::size_t last) const;
+  };
+  // Where in by_depth_ a depth lies, so that depth_slice() searches a few Gaussians, not all: the
+  // depth range is cut into as many buckets as there are Gaussians, bucket(d) = floor((d - origin)
+  // / width) clamped to [0, count - 1]; bucket b's Gaussians are [first[b], first[b + 1]). Since
+  // bucket() never decreases with d, every Gaussian before first[bucket(x)] is shallower than x and
+  // every one from first[bucket(x) + 1] on is deeper: the bound x's place is within its bucket.
+  struct DepthIndex {
+    double origin_mm = 0.0;
+    double inv_width = 1.0;
+    std::vector<std::size_t> first;  // count + 1 entries
+    void build(const std::vector<double>& sorted_depth_mm);
+    [[nodiscard]] std::size_t bucket(double depth_mm) const;
   };
   Columns by_depth_;
+  DepthIndex depth_index_;
   Columns by_label_;
   std::vector<std::size_t> label_begin_;  // label l is by_label_[label_begin_[l], label_begin_[l + 1])
   std::vector<std::size_t> order_;        // scratch for sorting
