@@ -124,8 +124,8 @@ struct PairLoop {
 };
 
 // The loops are branch-free so that gcc vectorises them: 2 doubles per SSE2 register on any
-// x86-64, 4 with fused multiply-adds in the x86-64-v3 (AVX2, FMA) clone, which the loader picks on
-// CPUs that have it.
+// x86-64, 4 with fused multiply-adds in the x86-64-v3 (AVX2, FMA) clone and 8 in the x86-64-v4
+// (AVX-512) clone, which the loader picks on CPUs that have them.
 
 // Eq. 6: every pair of the slice counts.
 HANDTRACK_TARGET_CLONES PairSums pair_sums(const ProjectedGaussian& p, const ImageMixtureSlice& q) {

@@ -1,7 +1,7 @@
 #pragma once
-// HANDTRACK_TARGET_CLONES: a hot kernel compiled twice, for x86-64-v3 (AVX2, FMA) and for the
-// baseline, the loader picking one per machine through an ifunc resolver (measured in
-// docs/BENCHMARKS.md "Kernels").
+// HANDTRACK_TARGET_CLONES: a hot kernel compiled three times, for x86-64-v4 (AVX-512), x86-64-v3
+// (AVX2, FMA) and the baseline, the loader picking one per machine through an ifunc resolver
+// (measured in docs/BENCHMARKS.md "Kernels").
 //
 // ThreadSanitizer builds get the baseline only: the resolver runs while the dynamic loader
 // relocates the program, before the TSan runtime is initialised, and its instrumented code
