@@ -1,5 +1,7 @@
 #include "handtrack/core/sequence.hpp"
 
+#include "file_error.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -13,17 +15,13 @@ namespace handtrack {
 namespace fs = std::filesystem;
 namespace {
 
-[[noreturn]] void fail(const fs::path& file, const std::string& what) {
-  throw std::runtime_error(file.string() + ": " + what);
-}
-
 double number_field(const nlohmann::json& j, const fs::path& file, const char* field, bool required,
                     double fallback) {
   if (!j.contains(field)) {
-    if (required) fail(file, std::string("missing field '") + field + "'");
+    if (required) fail_reading(file, std::string("missing field '") + field + "'");
     return fallback;
   }
-  if (!j[field].is_number()) fail(file, std::string("field '") + field + "' must be a number");
+  if (!j[field].is_number()) fail_reading(file, std::string("field '") + field + "' must be a number");
   return j[field].get<double>();
 }
 
@@ -51,7 +49,7 @@ std::optional<double> parse_cell(const std::string& cell, const fs::path& file, 
     used = 0;
   }
   if (used != cell.size() || !std::isfinite(v)) {
-    fail(file, "line " + std::to_string(line) + ": '" + cell + "' is not a number");
+    fail_reading(file, "line " + std::to_string(line) + ": '" + cell + "' is not a number");
   }
   return v;
 }
@@ -65,7 +63,7 @@ template <typename RowFn>
 void read_csv(const fs::path& file, size_t per_hand, size_t hands, RowFn&& row) {
   const size_t values = per_hand * hands;
   std::ifstream in(file);
-  if (!in) fail(file, "cannot open");
+  if (!in) fail_reading(file, "cannot open");
   std::string line;
   size_t n = 0;
   while (std::getline(in, line)) {
@@ -82,11 +80,11 @@ void read_csv(const fs::path& file, size_t per_hand, size_t hands, RowFn&& row) 
       } else if (cells.size() > 1 && (cells.size() - 1) % per_hand == 0) {
         why += " (" + std::to_string((cells.size() - 1) / per_hand) + " hands' columns: hand.json must name them)";
       }
-      fail(file, why);
+      fail_reading(file, why);
     }
     const auto frame = parse_cell(cells[0], file, n);
     if (!frame || *frame < 0 || *frame > kMaxFrameNumber || *frame != std::floor(*frame)) {
-      fail(file, "line " + std::to_string(n) + ": bad frame (a whole number in [0, " +
+      fail_reading(file, "line " + std::to_string(n) + ": bad frame (a whole number in [0, " +
                      std::to_string(kMaxFrameNumber) + "])");
     }
     std::vector<std::optional<double>> parsed;
@@ -135,19 +133,19 @@ fs::path frame_file(const fs::path& dir, int frame) {
 
 CameraIntrinsics read_camera_json(const fs::path& file) {
   std::ifstream in(file);
-  if (!in) fail(file, "cannot open (every sequence directory needs a camera.json)");
+  if (!in) fail_reading(file, "cannot open (every sequence directory needs a camera.json)");
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
-    fail(file, std::string("not valid JSON: ") + e.what());
+    fail_reading(file, std::string("not valid JSON: ") + e.what());
   }
-  if (!j.is_object()) fail(file, "expected a JSON object");
+  if (!j.is_object()) fail_reading(file, "expected a JSON object");
   CameraIntrinsics c;
   const double w = number_field(j, file, "width", true, 0);
   const double h = number_field(j, file, "height", true, 0);
   if (w != std::floor(w) || h != std::floor(h) || w < 1 || h < 1 || w > 8192 || h > 8192) {
-    fail(file, "fields 'width' and 'height' must be whole numbers in [8, 8192]");
+    fail_reading(file, "fields 'width' and 'height' must be whole numbers in [8, 8192]");
   }
   c.width = static_cast<int>(w);
   c.height = static_cast<int>(h);
@@ -157,7 +155,7 @@ CameraIntrinsics read_camera_json(const fs::path& file) {
   c.cy = number_field(j, file, "cy", true, 0);
   c.depth_scale_mm = number_field(j, file, "depth_scale_mm", false, 1.0);
   c.fps = number_field(j, file, "fps", false, 30.0);
-  if (auto why = c.problem(); !why.empty()) fail(file, why);
+  if (auto why = c.problem(); !why.empty()) fail_reading(file, why);
   return c;
 }
 
@@ -172,21 +170,23 @@ std::string hand_column_prefix(int hand) {
 
 std::vector<std::string> read_hand_json(const fs::path& file) {
   std::ifstream in(file);
-  if (!in) fail(file, "cannot open");
+  if (!in) fail_reading(file, "cannot open");
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
-    fail(file, std::string("not valid JSON: ") + e.what());
+    fail_reading(file, std::string("not valid JSON: ") + e.what());
   }
   const std::string expected = "field 'hands' must list 1 to " + std::to_string(kMaxSequenceHands) +
                                " of \"right\" and \"left\", e.g. {\"hands\":[\"right\",\"left\"]}";
-  if (!j.is_object() || !j.contains("hands")) fail(file, "missing " + expected);
+  if (!j.is_object() || !j.contains("hands")) fail_reading(file, "missing " + expected);
   const auto& list = j["hands"];
-  if (!list.is_array() || list.empty() || list.size() > static_cast<size_t>(kMaxSequenceHands)) fail(file, expected);
+  if (!list.is_array() || list.empty() || list.size() > static_cast<size_t>(kMaxSequenceHands)) {
+    fail_reading(file, expected);
+  }
   std::vector<std::string> hands;
   for (const auto& h : list) {
-    if (!h.is_string() || !valid_hand_name(h.get<std::string>())) fail(file, expected);
+    if (!h.is_string() || !valid_hand_name(h.get<std::string>())) fail_reading(file, expected);
     hands.push_back(h.get<std::string>());
   }
   return hands;
@@ -197,7 +197,7 @@ void write_hand_json(const fs::path& file, const std::vector<std::string>& hands
   nlohmann::json j = {{"hands", hands}};
   for (const auto& [key, value] : extra) j[key] = value;
   std::ofstream out(file);
-  if (!out) fail(file, "cannot write");
+  if (!out) fail_reading(file, "cannot write");
   out << j.dump() << "\n";
 }
 
@@ -206,15 +206,17 @@ void write_camera_json(const fs::path& file, const CameraIntrinsics& c) {
                       {"fy", c.fy},       {"cx", c.cx},         {"cy", c.cy},
                       {"depth_scale_mm", c.depth_scale_mm},     {"fps", c.fps}};
   std::ofstream out(file);
-  if (!out) fail(file, "cannot write");
+  if (!out) fail_reading(file, "cannot write");
   out << j.dump(1) << "\n";
 }
 
 SequenceReader::SequenceReader(fs::path dir, Annotations annotations) : dir_(std::move(dir)) {
-  if (!fs::is_directory(dir_)) fail(dir_, "not a directory");
+  if (!fs::is_directory(dir_)) fail_reading(dir_, "not a directory");
   camera_ = read_camera_json(dir_ / "camera.json");
   const fs::path depth_dir = dir_ / "depth";
-  if (!fs::is_directory(depth_dir)) fail(depth_dir, "missing (a sequence keeps its frames in depth/NNNNNN.png)");
+  if (!fs::is_directory(depth_dir)) {
+    fail_reading(depth_dir, "missing (a sequence keeps its frames in depth/NNNNNN.png)");
+  }
   for (const auto& entry : fs::directory_iterator(depth_dir)) {
     const auto name = entry.path().filename().string();
     if (entry.path().extension() != ".png") continue;
@@ -224,12 +226,13 @@ SequenceReader::SequenceReader(fs::path dir, Annotations annotations) : dir_(std
     }
     // A longer name is refused rather than wrapped.
     if (stem.size() > 9) {
-      fail(entry.path(), "frame number " + stem + " is too large (at most " + std::to_string(kMaxFrameNumber) + ")");
+      fail_reading(entry.path(),
+                   "frame number " + stem + " is too large (at most " + std::to_string(kMaxFrameNumber) + ")");
     }
     frames_.push_back(std::stoi(stem));
   }
   std::sort(frames_.begin(), frames_.end());
-  if (frames_.empty()) fail(depth_dir, "holds no NNNNNN.png frames");
+  if (frames_.empty()) fail_reading(depth_dir, "holds no NNNNNN.png frames");
   if (annotations == Annotations::kIgnore) return;
 
   if (const auto hj = dir_ / "hand.json"; fs::exists(hj)) hands_ = read_hand_json(hj);
@@ -257,7 +260,7 @@ SequenceReader::SequenceReader(fs::path dir, Annotations annotations) : dir_(std
         Joints joints;
         for (size_t k = 0; k < kNumJoints; ++k) {
           const auto p = point(v, first + 3 * k);
-          if (!p) fail(jf, "frame " + std::to_string(frame) + ": empty cell");
+          if (!p) fail_reading(jf, "frame " + std::to_string(frame) + ": empty cell");
           joints[k] = *p;
         }
         per_hand[h] = joints;
@@ -301,7 +304,7 @@ std::optional<Joints> SequenceReader::joints(size_t i, int hand) const {
 }
 
 SequenceWriter::SequenceWriter(fs::path dir, const CameraIntrinsics& camera) : dir_(std::move(dir)), camera_(camera) {
-  if (auto why = camera.problem(); !why.empty()) fail(dir_, "bad camera: " + why);
+  if (auto why = camera.problem(); !why.empty()) fail_reading(dir_, "bad camera: " + why);
   fs::create_directories(dir_ / "depth");
   write_camera_json(dir_ / "camera.json", camera_);
 }
@@ -368,7 +371,7 @@ void SequenceWriter::flush() {
   const auto hands = static_cast<size_t>(hand_count_);
   if (!groundtruth_.empty()) {
     std::ofstream out(dir_ / "groundtruth.csv");
-    if (!out) fail(dir_ / "groundtruth.csv", "cannot write");
+    if (!out) fail_reading(dir_ / "groundtruth.csv", "cannot write");
     out << header(false, hand_count_) << "\n";
     for (const auto& [frame, per_hand] : groundtruth_) {
       out << frame;
@@ -383,7 +386,7 @@ void SequenceWriter::flush() {
   }
   if (!joints_.empty()) {
     std::ofstream out(dir_ / "joints.csv");
-    if (!out) fail(dir_ / "joints.csv", "cannot write");
+    if (!out) fail_reading(dir_ / "joints.csv", "cannot write");
     out << header(true, hand_count_) << "\n";
     for (const auto& [frame, per_hand] : joints_) {
       out << frame;

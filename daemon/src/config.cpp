@@ -303,7 +303,7 @@ std::string range_text(const Field& f) {
       f.ref);
 }
 
-[[noreturn]] void fail(const std::string& origin, const std::string& what) {
+[[noreturn]] void throw_config_error(const std::string& origin, const std::string& what) {
   throw ConfigError(origin + ": " + what);
 }
 
@@ -375,27 +375,27 @@ void apply_node(DaemonConfig& c, const Field& f, const toml::node& node, const s
           } else if (auto i = node.value_exact<int64_t>()) {
             ref(c) = static_cast<double>(*i);
           } else {
-            fail(origin, fmt::format("{} must be a number ({})", name, range_text(f)));
+            throw_config_error(origin, fmt::format("{} must be a number ({})", name, range_text(f)));
           }
         } else if constexpr (std::is_same_v<T, BoolRef>) {
           auto v = node.value_exact<bool>();
-          if (!v) fail(origin, fmt::format("{} must be true or false", name));
+          if (!v) throw_config_error(origin, fmt::format("{} must be true or false", name));
           ref(c) = *v;
         } else if constexpr (std::is_same_v<T, StringRef>) {
           auto v = node.value_exact<std::string>();
-          if (!v) fail(origin, fmt::format("{} must be a string", name));
+          if (!v) throw_config_error(origin, fmt::format("{} must be a string", name));
           ref(c) = *v;
         } else if constexpr (std::is_same_v<T, ChoiceRef>) {
           auto v = node.value_exact<std::string>();
           if (!v || !ref.set(c, *v)) {
-            fail(origin, fmt::format("{} = {}: {}", name, v ? toml_quote(*v) : std::string("(not a string)"),
+            throw_config_error(origin, fmt::format("{} = {}: {}", name, v ? toml_quote(*v) : std::string("(not a string)"),
                                      range_text(f)));
           }
         } else {
           auto v = node.value_exact<int64_t>();
-          if (!v) fail(origin, fmt::format("{} must be an integer ({})", name, range_text(f)));
+          if (!v) throw_config_error(origin, fmt::format("{} must be an integer ({})", name, range_text(f)));
           if (static_cast<double>(*v) < f.min || static_cast<double>(*v) > f.max) {
-            fail(origin, fmt::format("{} = {} is out of range ({})", name, *v, range_text(f)));
+            throw_config_error(origin, fmt::format("{} = {} is out of range ({})", name, *v, range_text(f)));
           }
           using V = std::remove_reference_t<decltype(ref(c))>;
           ref(c) = static_cast<V>(*v);
@@ -413,7 +413,7 @@ void walk(DaemonConfig& c, const toml::table& table, const std::string& prefix, 
     }
     const Field* f = find_field(name);
     if (f == nullptr) {
-      fail(origin, fmt::format("unknown field '{}' (see handtrackd --print-config for the fields)", name));
+      throw_config_error(origin, fmt::format("unknown field '{}' (see handtrackd --print-config for the fields)", name));
     }
     apply_node(c, *f, node, origin);
   }
@@ -427,7 +427,7 @@ DaemonConfig from_table(const toml::table& table, const std::string& origin) {
     try {
       c.tracker.scale = load_hand_profile(c.hand_profile);
     } catch (const std::exception& e) {
-      fail(origin, std::string("tracker.hand_profile: ") + e.what());
+      throw_config_error(origin, std::string("tracker.hand_profile: ") + e.what());
     }
   }
   return c;
@@ -445,25 +445,25 @@ void validate(const DaemonConfig& config, const std::string& origin) {
             return;
           } else if constexpr (std::is_same_v<T, StringRef>) {
             const auto n = static_cast<double>(ref(c).size());
-            if (n < f.min || n > f.max) fail(origin, fmt::format("{} = {}: {}", f.name, toml_quote(ref(c)), range_text(f)));
+            if (n < f.min || n > f.max) throw_config_error(origin, fmt::format("{} = {}: {}", f.name, toml_quote(ref(c)), range_text(f)));
           } else {
             const auto v = static_cast<double>(ref(c));
             if (!std::isfinite(v) || v < f.min || v > f.max) {
-              fail(origin, fmt::format("{} = {} is out of range ({})", f.name, value_text(f, c), range_text(f)));
+              throw_config_error(origin, fmt::format("{} = {} is out of range ({})", f.name, value_text(f, c), range_text(f)));
             }
           }
         },
         f.ref);
   }
   if (c.shm_name.find('/') != std::string::npos) {
-    fail(origin, fmt::format("daemon.shm_name = {}: allowed: a name without '/'", toml_quote(c.shm_name)));
+    throw_config_error(origin, fmt::format("daemon.shm_name = {}: allowed: a name without '/'", toml_quote(c.shm_name)));
   }
   if (c.tracker.input.near_mm >= c.tracker.input.far_mm) {
-    fail(origin, fmt::format("tracker.input.near_mm = {} must be less than tracker.input.far_mm = {}",
+    throw_config_error(origin, fmt::format("tracker.input.near_mm = {} must be less than tracker.input.far_mm = {}",
                              format_number(c.tracker.input.near_mm), format_number(c.tracker.input.far_mm)));
   }
   if (c.tracker.input.quadtree_min_leaf_px > c.tracker.input.quadtree_root_px) {
-    fail(origin, fmt::format("tracker.input.quadtree_min_leaf_px = {} must not exceed tracker.input.quadtree_root_px = {}",
+    throw_config_error(origin, fmt::format("tracker.input.quadtree_min_leaf_px = {} must not exceed tracker.input.quadtree_root_px = {}",
                              c.tracker.input.quadtree_min_leaf_px, c.tracker.input.quadtree_root_px));
   }
 }

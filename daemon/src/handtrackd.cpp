@@ -32,7 +32,7 @@ using namespace handtrack::daemon;
 
 namespace {
 
-int fail(const std::string& message) { return report_error("handtrackd", message, 1); }
+int exit_with_error(const std::string& message) { return report_error("handtrackd", message, 1); }
 
 const char* device_state_name(ipc::DeviceState state) {
   switch (state) {
@@ -147,7 +147,7 @@ int handtrack::daemon::run_handtrackd(int argc, char** argv, const SourceFactory
   try {
     config = load();
   } catch (const ConfigError& e) {
-    return fail(e.what());
+    return exit_with_error(e.what());
   }
   if (print_config) {
     std::fputs(describe_config(config).c_str(), stdout);
@@ -159,10 +159,10 @@ int handtrack::daemon::run_handtrackd(int argc, char** argv, const SourceFactory
   try {
     source_ptr = source_factory(config.source, config.source_options);
   } catch (const std::exception& e) {
-    return fail(e.what());
+    return exit_with_error(e.what());
   }
   if (!config.record_dir.empty()) {
-    if (const auto problem = record_dir_problem(config.record_dir); !problem.empty()) return fail(problem);
+    if (const auto problem = record_dir_problem(config.record_dir); !problem.empty()) return exit_with_error(problem);
   }
 
   // Signals go to this thread only (sigtimedwait below): block them before any thread starts.
@@ -186,7 +186,7 @@ int handtrack::daemon::run_handtrackd(int argc, char** argv, const SourceFactory
     ring.emplace(ipc::PoseRingWriter::Options{.name = config.shm_name,
                                               .capacity = static_cast<uint32_t>(config.ring_capacity)});
   } catch (const std::exception& e) {
-    return fail(e.what());
+    return exit_with_error(e.what());
   }
   if (!ring->removed_foreign_owner().empty()) {
     log().warn("removed /{} of {}: an object of another user under our name is never written to or trusted",
@@ -200,7 +200,7 @@ int handtrack::daemon::run_handtrackd(int argc, char** argv, const SourceFactory
   if (!start_beating(pipeline, *ring, &why)) {
     ring.reset();
     ipc::PoseRingWriter::remove(config.shm_name);
-    return fail(why);
+    return exit_with_error(why);
   }
   log().info("handtrackd {} on {}: publishing to /{} (epoch {}), {} particles x {} iterations{}",
              HANDTRACK_VERSION, pipeline.source().describe(), config.shm_name, ring->epoch(), config.tracker.particles,

@@ -1,11 +1,12 @@
 #include "handtrack/synth/motions.hpp"
 
+#include "angles.hpp"
+
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -15,7 +16,6 @@ namespace {
 
 using Eigen::Vector3d;
 using HandAngles = std::array<FingerAngles, kNumFingers>;
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 // Period of one cycle of each motion in slow-half seconds (kMotionNames order; random uses its own
 // incommensurate frequencies). Chosen for joint speeds of ~1.5-2.5 rad/s slow, ~4-6 rad/s fast.

@@ -1,5 +1,7 @@
 #include "handtrack/synth/two_hand_motions.hpp"
 
+#include "angles.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -15,7 +17,6 @@ using Eigen::AngleAxisd;
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 using HandAngles = std::array<FingerAngles, kNumFingers>;
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 enum Scene { kApart, kClap, kCross, kPinch };  // kTwoHandMotionNames order
 

@@ -28,12 +28,12 @@ std::weak_ptr<Runtime>& current_runtime() {
   return r;
 }
 
+}  // namespace
+
 std::shared_ptr<spdlog::logger> logger() {
   auto log = spdlog::get("daemon");
   return log ? log : spdlog::default_logger();
 }
-
-}  // namespace
 
 struct Runtime::Listeners final : openni::OpenNI::DeviceConnectedListener,
                                   openni::OpenNI::DeviceDisconnectedListener,

@@ -6,11 +6,6 @@
 
 namespace handtrack::daemon::openni2 {
 
-std::shared_ptr<spdlog::logger> logger() {
-  auto log = spdlog::get("daemon");
-  return log ? log : spdlog::default_logger();
-}
-
 std::string extended_error() {
   const char* e = openni::OpenNI::getExtendedError();
   std::string s = e ? e : "";

@@ -30,8 +30,6 @@ namespace handtrack::daemon::openni2 {
 // timeout is reported within one slice rather than at the end of the timeout.
 inline constexpr std::chrono::milliseconds kWaitSlice{50};
 
-// The daemon's logger (or spdlog's default before it exists).
-std::shared_ptr<spdlog::logger> logger();
 // OpenNI2's extended error of the last call, trimmed to one line (empty: none).
 std::string extended_error();
 // `what` with the extended error appended in parentheses, when there is one.
