@@ -2,9 +2,9 @@
 // handtrack-source-helper (daemon/sources/isolated), so a recording that crashes or hangs it
 // must never take the daemon down.
 // - 240 mutants of the real recording (200 single-byte changes, half of them in the first 4 KiB
-//   where the headers are, and 40 truncations): no death by signal, no hang; a refused file gives
-//   exit 1 and one error line naming it; where the source failed while streaming, the daemon stays
-//   alive, its ring says "error", and the log says why.
+//   where the headers are, and 40 truncations), four daemons at a time: no death by signal, no
+//   hang; a refused file gives exit 1 and one error line naming it; where the source failed while
+//   streaming, the daemon stays alive, its ring says "error", and the log says why.
 // - A helper killed by SIGSEGV while streaming (what a driver fault looks like): the same.
 // Skips without the recording (../shared/data, only in the project workspace).
 #include "../child_process.hpp"
@@ -14,12 +14,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <mutex>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -107,43 +110,70 @@ PlayResult play(const fs::path& file, const TempDir& dir, const std::string& shm
   return run;
 }
 
+// One mutant of the recording: a byte changed, or the file cut short.
+struct Mutation {
+  std::size_t at = 0;      // the byte changed, or the length cut to
+  char value = 0;
+  bool truncation = false;
+  [[nodiscard]] std::string describe() const {
+    return truncation ? "truncated to " + std::to_string(at) + " bytes"
+                      : "byte " + std::to_string(at) + " = " + std::to_string(static_cast<unsigned char>(value));
+  }
+};
+
 TEST(HostileRecordings, MutantsNeverTakeTheDaemonDown) {
   SKIP_WITHOUT_RECORDING();
   const std::vector<char> original = read_bytes(kRecording);
   ASSERT_GT(original.size(), 65536U);
-  const TempDir dir("oni-mutants");
-  const ShmName shm("oni-mutants");
-  const fs::path mutant = dir / "mutant.oni";
-  std::mt19937_64 rng(20261124);
-  std::map<Outcome, int> outcomes;
-  int failures = 0;
   constexpr int kByteMutants = 200;
   constexpr int kTruncations = 40;
-  for (int i = 0; i < kByteMutants + kTruncations; ++i) {
-    std::vector<char> bytes = original;
-    std::size_t length = bytes.size();
-    std::string what;
-    if (i < kByteMutants) {
-      const std::size_t span = i % 2 == 0 ? 4096 : bytes.size();
-      const std::size_t at = std::uniform_int_distribution<std::size_t>(0, span - 1)(rng);
-      const char value = static_cast<char>(std::uniform_int_distribution<int>(0, 255)(rng));
-      what = "byte " + std::to_string(at) + " = " + std::to_string(static_cast<unsigned char>(value));
-      bytes[at] = value;
-    } else {
-      length = std::uniform_int_distribution<std::size_t>(0, bytes.size() - 1)(rng);
-      what = "truncated to " + std::to_string(length) + " bytes";
-    }
-    write_bytes(mutant, bytes, length);
-    const PlayResult run = play(mutant, dir, shm.str());
-    ++outcomes[run.outcome];
-    if (!run.problem.empty()) {
-      ADD_FAILURE() << "mutant " << i << " (" << what << "): " << run.problem;
-      if (++failures >= 5) break;
-    }
+  std::mt19937_64 rng(20261124);
+  std::vector<Mutation> mutations;
+  for (int i = 0; i < kByteMutants; ++i) {
+    const std::size_t span = i % 2 == 0 ? 4096 : original.size();
+    const std::size_t at = std::uniform_int_distribution<std::size_t>(0, span - 1)(rng);
+    mutations.push_back({at, static_cast<char>(std::uniform_int_distribution<int>(0, 255)(rng)), false});
   }
-  std::cout << "240 mutants: " << outcomes[Outcome::kPlayed] << " played, " << outcomes[Outcome::kRefused]
-            << " refused by OpenNI2 with an error line, " << outcomes[Outcome::kHelperDiedOpening]
-            << " killed the helper while opening (exit 1, error line), " << outcomes[Outcome::kFailedWhileStreaming]
+  for (int i = 0; i < kTruncations; ++i) {
+    mutations.push_back({std::uniform_int_distribution<std::size_t>(0, original.size() - 1)(rng), 0, true});
+  }
+
+  // Four daemons play mutants at once, each with its own file and ring: a play is mostly waiting
+  // (OpenNI2 starting and shutting down its drivers in the helper), a fifth of it CPU.
+  constexpr int kPlayers = 4;
+  std::mutex mutex;
+  std::map<Outcome, int> outcomes;
+  std::vector<std::string> failures;
+  std::atomic<std::size_t> next{0};
+  const auto player = [&](int p) {
+    const TempDir dir("oni-mutants-" + std::to_string(p));
+    const ShmName shm("oni-mutants-" + std::to_string(p));
+    const fs::path mutant = dir / "mutant.oni";
+    std::vector<char> bytes = original;
+    for (std::size_t i; (i = next++) < mutations.size();) {
+      const Mutation& m = mutations[i];
+      if (m.truncation) {
+        write_bytes(mutant, original, m.at);
+      } else {
+        bytes[m.at] = m.value;
+        write_bytes(mutant, bytes, bytes.size());
+        bytes[m.at] = original[m.at];
+      }
+      const PlayResult run = play(mutant, dir, shm.str());
+      const std::lock_guard lock(mutex);
+      ++outcomes[run.outcome];
+      if (!run.problem.empty()) failures.push_back("mutant " + std::to_string(i) + " (" + m.describe() + "): " + run.problem);
+      if (failures.size() >= 5) next = mutations.size();
+    }
+  };
+  std::vector<std::thread> players;
+  for (int p = 0; p < kPlayers; ++p) players.emplace_back(player, p);
+  for (auto& t : players) t.join();
+  for (const auto& f : failures) ADD_FAILURE() << f;
+  std::cout << mutations.size() << " mutants: " << outcomes[Outcome::kPlayed] << " played, "
+            << outcomes[Outcome::kRefused] << " refused by OpenNI2 with an error line, "
+            << outcomes[Outcome::kHelperDiedOpening] << " killed the helper while opening (exit 1, error line), "
+            << outcomes[Outcome::kFailedWhileStreaming]
             << " failed while streaming (daemon alive, ring state error)\n";
 }
 
