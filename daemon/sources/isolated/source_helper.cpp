@@ -6,6 +6,7 @@
 #include "helper_channel.hpp"
 
 #include "../source_factories.hpp"
+#include "logging.hpp"
 
 #include <exception>
 #include <memory>
@@ -94,10 +95,14 @@ void serve(Channel& channel) {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
   // Die with the daemon even when a driver hangs: a helper must never outlive it holding the
   // camera. (A daemon gone before this line closed the socket: serve() returns at once.)
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  // OpenNI2's lines from here go to the daemon's stderr in the daemon's format, at the level the
+  // daemon had when it started this helper (argv[1], a spdlog level name).
+  setup_logging(LogLevel::kInfo);
+  if (argc > 1) log().set_level(spdlog::level::from_str(argv[1]));
   Channel channel(kChannelFd);
   serve(channel);
   return 0;

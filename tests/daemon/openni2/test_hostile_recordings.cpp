@@ -6,6 +6,7 @@
 //   hang; a refused file gives exit 1 and one error line naming it; where the source failed while
 //   streaming, the daemon stays alive, its ring says "error", and the log says why.
 // - A helper killed by SIGSEGV while streaming (what a driver fault looks like): the same.
+// - The helper's own log lines follow the daemon's format and level.
 // Skips without the recording (../shared/data, only in the project workspace).
 #include "../child_process.hpp"
 
@@ -175,6 +176,24 @@ TEST(HostileRecordings, MutantsNeverTakeTheDaemonDown) {
             << outcomes[Outcome::kHelperDiedOpening] << " killed the helper while opening (exit 1, error line), "
             << outcomes[Outcome::kFailedWhileStreaming]
             << " failed while streaming (daemon alive, ring state error)\n";
+}
+
+// The helper's lines (OpenNI2 starting, the recording opened) reach the daemon's stderr in the
+// daemon's format and obey its --log-level: none on stdout, none below the level.
+TEST(OniThroughHandtrackd, TheHelperLogsLikeTheDaemonAtItsLevel) {
+  SKIP_WITHOUT_RECORDING();
+  const TempDir dir("oni-helper-log");
+  const ShmName shm("oni-helper-log");
+  for (const std::string level : {"info", "warn"}) {
+    SCOPED_TRACE(level);
+    Child daemon({HANDTRACKD_EXE, "--config", std::string(HANDTRACK_SOURCE_DIR) + "/data/handtrackd.toml", "--source",
+                  "oni:" + kRecording.string(), "--fast", "--frames", "5", "--shm-name", shm.str(), "--log-level", level},
+                 dir / "out", dir / "err");
+    ASSERT_EQ(daemon.wait(30s), 0) << daemon.err();
+    EXPECT_EQ(daemon.out(), "");
+    const bool helper_line = daemon.err().find("handtrackd: info: OpenNI2 ") != std::string::npos;
+    EXPECT_EQ(helper_line, level == "info") << daemon.err();
+  }
 }
 
 // The helper's pid: the daemon's only child.
