@@ -389,7 +389,7 @@ void apply_node(DaemonConfig& c, const Field& f, const toml::node& node, const s
           auto v = node.value_exact<std::string>();
           if (!v || !ref.set(c, *v)) {
             throw_config_error(origin, fmt::format("{} = {}: {}", name, v ? toml_quote(*v) : std::string("(not a string)"),
-                                     range_text(f)));
+                                                   range_text(f)));
           }
         } else {
           auto v = node.value_exact<int64_t>();
@@ -460,11 +460,11 @@ void validate(const DaemonConfig& config, const std::string& origin) {
   }
   if (c.tracker.input.near_mm >= c.tracker.input.far_mm) {
     throw_config_error(origin, fmt::format("tracker.input.near_mm = {} must be less than tracker.input.far_mm = {}",
-                             format_number(c.tracker.input.near_mm), format_number(c.tracker.input.far_mm)));
+                                           format_number(c.tracker.input.near_mm), format_number(c.tracker.input.far_mm)));
   }
   if (c.tracker.input.quadtree_min_leaf_px > c.tracker.input.quadtree_root_px) {
     throw_config_error(origin, fmt::format("tracker.input.quadtree_min_leaf_px = {} must not exceed tracker.input.quadtree_root_px = {}",
-                             c.tracker.input.quadtree_min_leaf_px, c.tracker.input.quadtree_root_px));
+                                           c.tracker.input.quadtree_min_leaf_px, c.tracker.input.quadtree_root_px));
   }
 }
 

@@ -14,8 +14,7 @@
 #include "../source_factories.hpp"
 
 #include "handtrack/common/clock.hpp"
-
-#include <spdlog/spdlog.h>
+#include "logging.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -162,9 +161,8 @@ class IsolatedSource final : public DepthSource {
     posix_spawnattr_setsigdefault(&attributes, &defaults);
     posix_spawnattr_setpgroup(&attributes, 0);
     posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETPGROUP);
-    // The helper logs at the daemon's level (the "daemon" logger, or spdlog's default before it).
-    const auto daemon_log = spdlog::get("daemon");
-    const auto name = spdlog::level::to_string_view((daemon_log ? daemon_log : spdlog::default_logger())->level());
+    // The helper logs at the daemon's level.
+    const auto name = spdlog::level::to_string_view(log().level());
     std::string level(name.data(), name.size());
     char* argv[] = {const_cast<char*>(helper.c_str()), level.data(), nullptr};
     const int rc = ::posix_spawn(&pid_, helper.c_str(), &actions, &attributes, argv, environ);

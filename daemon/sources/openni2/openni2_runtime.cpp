@@ -1,8 +1,8 @@
 #include "openni2_runtime.hpp"
 
-#include <OpenNI.h>
+#include "logging.hpp"
 
-#include <spdlog/spdlog.h>
+#include <OpenNI.h>
 
 #include <algorithm>
 #include <cstring>
@@ -29,11 +29,6 @@ std::weak_ptr<Runtime>& current_runtime() {
 }
 
 }  // namespace
-
-std::shared_ptr<spdlog::logger> logger() {
-  auto log = spdlog::get("daemon");
-  return log ? log : spdlog::default_logger();
-}
 
 struct Runtime::Listeners final : openni::OpenNI::DeviceConnectedListener,
                                   openni::OpenNI::DeviceDisconnectedListener,
@@ -68,10 +63,10 @@ bool Runtime::start(std::string* why) {
       openni::OpenNI::addDeviceStateChangedListener(listeners_.get()) == openni::STATUS_OK) {
     listeners_->registered = true;
   } else {
-    logger()->warn("OpenNI2: could not register device event listeners; unplug is detected by timeouts only");
+    log().warn("OpenNI2: could not register device event listeners; unplug is detected by timeouts only");
   }
   const openni::Version v = openni::OpenNI::getVersion();
-  logger()->info("OpenNI2 {}.{}.{}.{} initialized", v.major, v.minor, v.maintenance, v.build);
+  log().info("OpenNI2 {}.{}.{}.{} initialized", v.major, v.minor, v.maintenance, v.build);
   return true;
 }
 
@@ -115,11 +110,11 @@ std::vector<std::string> Runtime::device_uris() {
 
 void Runtime::on_connected(const char* uri) {
   // A waiting camera source finds the new device by itself: its open() is retried every second.
-  logger()->info("OpenNI2: device connected: {}", uri ? uri : "?");
+  log().info("OpenNI2: device connected: {}", uri ? uri : "?");
 }
 
 void Runtime::on_disconnected(const char* uri) {
-  logger()->info("OpenNI2: device disconnected: {}", uri ? uri : "?");
+  log().info("OpenNI2: device disconnected: {}", uri ? uri : "?");
   on_error_state(uri);
 }
 

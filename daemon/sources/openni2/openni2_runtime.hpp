@@ -15,14 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace spdlog {
-class logger;
-}
-
 namespace handtrack::daemon::openni2 {
-
-// The daemon's logger (or spdlog's default before it exists).
-std::shared_ptr<spdlog::logger> logger();
 
 // What a live source learns from OpenNI2's device events about the device it has open.
 struct DeviceWatch {

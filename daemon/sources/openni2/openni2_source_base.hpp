@@ -8,13 +8,12 @@
 // (atomics, openni2_runtime.hpp).
 #include "handtrack/daemon/depth_source.hpp"
 
+#include "logging.hpp"
 #include "openni2_runtime.hpp"
 
 #include "handtrack/common/clock.hpp"
 
 #include <OpenNI.h>
-
-#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <atomic>
