@@ -18,10 +18,10 @@ namespace {
 double number_field(const nlohmann::json& j, const fs::path& file, const char* field, bool required,
                     double fallback) {
   if (!j.contains(field)) {
-    if (required) fail_reading(file, std::string("missing field '") + field + "'");
+    if (required) throw_file_error(file, std::string("missing field '") + field + "'");
     return fallback;
   }
-  if (!j[field].is_number()) fail_reading(file, std::string("field '") + field + "' must be a number");
+  if (!j[field].is_number()) throw_file_error(file, std::string("field '") + field + "' must be a number");
   return j[field].get<double>();
 }
 
@@ -49,7 +49,7 @@ std::optional<double> parse_cell(const std::string& cell, const fs::path& file, 
     used = 0;
   }
   if (used != cell.size() || !std::isfinite(v)) {
-    fail_reading(file, "line " + std::to_string(line) + ": '" + cell + "' is not a number");
+    throw_file_error(file, "line " + std::to_string(line) + ": '" + cell + "' is not a number");
   }
   return v;
 }
@@ -63,7 +63,7 @@ template <typename RowFn>
 void read_csv(const fs::path& file, size_t per_hand, size_t hands, RowFn&& row) {
   const size_t values = per_hand * hands;
   std::ifstream in(file);
-  if (!in) fail_reading(file, "cannot open");
+  if (!in) throw_file_error(file, "cannot open");
   std::string line;
   size_t n = 0;
   while (std::getline(in, line)) {
@@ -80,12 +80,12 @@ void read_csv(const fs::path& file, size_t per_hand, size_t hands, RowFn&& row) 
       } else if (cells.size() > 1 && (cells.size() - 1) % per_hand == 0) {
         why += " (" + std::to_string((cells.size() - 1) / per_hand) + " hands' columns: hand.json must name them)";
       }
-      fail_reading(file, why);
+      throw_file_error(file, why);
     }
     const auto frame = parse_cell(cells[0], file, n);
     if (!frame || *frame < 0 || *frame > kMaxFrameNumber || *frame != std::floor(*frame)) {
-      fail_reading(file, "line " + std::to_string(n) + ": bad frame (a whole number in [0, " +
-                     std::to_string(kMaxFrameNumber) + "])");
+      throw_file_error(file, "line " + std::to_string(n) + ": bad frame (a whole number in [0, " +
+                       std::to_string(kMaxFrameNumber) + "])");
     }
     std::vector<std::optional<double>> parsed;
     for (size_t i = 1; i < cells.size(); ++i) parsed.push_back(parse_cell(cells[i], file, n));
@@ -133,19 +133,19 @@ fs::path frame_file(const fs::path& dir, int frame) {
 
 CameraIntrinsics read_camera_json(const fs::path& file) {
   std::ifstream in(file);
-  if (!in) fail_reading(file, "cannot open (every sequence directory needs a camera.json)");
+  if (!in) throw_file_error(file, "cannot open (every sequence directory needs a camera.json)");
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
-    fail_reading(file, std::string("not valid JSON: ") + e.what());
+    throw_file_error(file, std::string("not valid JSON: ") + e.what());
   }
-  if (!j.is_object()) fail_reading(file, "expected a JSON object");
+  if (!j.is_object()) throw_file_error(file, "expected a JSON object");
   CameraIntrinsics c;
   const double w = number_field(j, file, "width", true, 0);
   const double h = number_field(j, file, "height", true, 0);
   if (w != std::floor(w) || h != std::floor(h) || w < 1 || h < 1 || w > 8192 || h > 8192) {
-    fail_reading(file, "fields 'width' and 'height' must be whole numbers in [8, 8192]");
+    throw_file_error(file, "fields 'width' and 'height' must be whole numbers in [8, 8192]");
   }
   c.width = static_cast<int>(w);
   c.height = static_cast<int>(h);
@@ -155,7 +155,7 @@ CameraIntrinsics read_camera_json(const fs::path& file) {
   c.cy = number_field(j, file, "cy", true, 0);
   c.depth_scale_mm = number_field(j, file, "depth_scale_mm", false, 1.0);
   c.fps = number_field(j, file, "fps", false, 30.0);
-  if (auto why = c.problem(); !why.empty()) fail_reading(file, why);
+  if (auto why = c.problem(); !why.empty()) throw_file_error(file, why);
   return c;
 }
 
@@ -170,23 +170,23 @@ std::string hand_column_prefix(int hand) {
 
 std::vector<std::string> read_hand_json(const fs::path& file) {
   std::ifstream in(file);
-  if (!in) fail_reading(file, "cannot open");
+  if (!in) throw_file_error(file, "cannot open");
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
-    fail_reading(file, std::string("not valid JSON: ") + e.what());
+    throw_file_error(file, std::string("not valid JSON: ") + e.what());
   }
   const std::string expected = "field 'hands' must list 1 to " + std::to_string(kMaxSequenceHands) +
                                " of \"right\" and \"left\", e.g. {\"hands\":[\"right\",\"left\"]}";
-  if (!j.is_object() || !j.contains("hands")) fail_reading(file, "missing " + expected);
+  if (!j.is_object() || !j.contains("hands")) throw_file_error(file, "missing " + expected);
   const auto& list = j["hands"];
   if (!list.is_array() || list.empty() || list.size() > static_cast<size_t>(kMaxSequenceHands)) {
-    fail_reading(file, expected);
+    throw_file_error(file, expected);
   }
   std::vector<std::string> hands;
   for (const auto& h : list) {
-    if (!h.is_string() || !valid_hand_name(h.get<std::string>())) fail_reading(file, expected);
+    if (!h.is_string() || !valid_hand_name(h.get<std::string>())) throw_file_error(file, expected);
     hands.push_back(h.get<std::string>());
   }
   return hands;
@@ -197,7 +197,7 @@ void write_hand_json(const fs::path& file, const std::vector<std::string>& hands
   nlohmann::json j = {{"hands", hands}};
   for (const auto& [key, value] : extra) j[key] = value;
   std::ofstream out(file);
-  if (!out) fail_reading(file, "cannot write");
+  if (!out) throw_file_error(file, "cannot write");
   out << j.dump() << "\n";
 }
 
@@ -206,16 +206,16 @@ void write_camera_json(const fs::path& file, const CameraIntrinsics& c) {
                       {"fy", c.fy},       {"cx", c.cx},         {"cy", c.cy},
                       {"depth_scale_mm", c.depth_scale_mm},     {"fps", c.fps}};
   std::ofstream out(file);
-  if (!out) fail_reading(file, "cannot write");
+  if (!out) throw_file_error(file, "cannot write");
   out << j.dump(1) << "\n";
 }
 
 SequenceReader::SequenceReader(fs::path dir, Annotations annotations) : dir_(std::move(dir)) {
-  if (!fs::is_directory(dir_)) fail_reading(dir_, "not a directory");
+  if (!fs::is_directory(dir_)) throw_file_error(dir_, "not a directory");
   camera_ = read_camera_json(dir_ / "camera.json");
   const fs::path depth_dir = dir_ / "depth";
   if (!fs::is_directory(depth_dir)) {
-    fail_reading(depth_dir, "missing (a sequence keeps its frames in depth/NNNNNN.png)");
+    throw_file_error(depth_dir, "missing (a sequence keeps its frames in depth/NNNNNN.png)");
   }
   for (const auto& entry : fs::directory_iterator(depth_dir)) {
     const auto name = entry.path().filename().string();
@@ -226,13 +226,13 @@ SequenceReader::SequenceReader(fs::path dir, Annotations annotations) : dir_(std
     }
     // A longer name is refused rather than wrapped.
     if (stem.size() > 9) {
-      fail_reading(entry.path(),
-                   "frame number " + stem + " is too large (at most " + std::to_string(kMaxFrameNumber) + ")");
+      throw_file_error(entry.path(),
+                       "frame number " + stem + " is too large (at most " + std::to_string(kMaxFrameNumber) + ")");
     }
     frames_.push_back(std::stoi(stem));
   }
   std::sort(frames_.begin(), frames_.end());
-  if (frames_.empty()) fail_reading(depth_dir, "holds no NNNNNN.png frames");
+  if (frames_.empty()) throw_file_error(depth_dir, "holds no NNNNNN.png frames");
   if (annotations == Annotations::kIgnore) return;
 
   if (const auto hj = dir_ / "hand.json"; fs::exists(hj)) hands_ = read_hand_json(hj);
@@ -260,7 +260,7 @@ SequenceReader::SequenceReader(fs::path dir, Annotations annotations) : dir_(std
         Joints joints;
         for (size_t k = 0; k < kNumJoints; ++k) {
           const auto p = point(v, first + 3 * k);
-          if (!p) fail_reading(jf, "frame " + std::to_string(frame) + ": empty cell");
+          if (!p) throw_file_error(jf, "frame " + std::to_string(frame) + ": empty cell");
           joints[k] = *p;
         }
         per_hand[h] = joints;
@@ -304,7 +304,7 @@ std::optional<Joints> SequenceReader::joints(size_t i, int hand) const {
 }
 
 SequenceWriter::SequenceWriter(fs::path dir, const CameraIntrinsics& camera) : dir_(std::move(dir)), camera_(camera) {
-  if (auto why = camera.problem(); !why.empty()) fail_reading(dir_, "bad camera: " + why);
+  if (auto why = camera.problem(); !why.empty()) throw_file_error(dir_, "bad camera: " + why);
   fs::create_directories(dir_ / "depth");
   write_camera_json(dir_ / "camera.json", camera_);
 }
@@ -371,7 +371,7 @@ void SequenceWriter::flush() {
   const auto hands = static_cast<size_t>(hand_count_);
   if (!groundtruth_.empty()) {
     std::ofstream out(dir_ / "groundtruth.csv");
-    if (!out) fail_reading(dir_ / "groundtruth.csv", "cannot write");
+    if (!out) throw_file_error(dir_ / "groundtruth.csv", "cannot write");
     out << header(false, hand_count_) << "\n";
     for (const auto& [frame, per_hand] : groundtruth_) {
       out << frame;
@@ -386,7 +386,7 @@ void SequenceWriter::flush() {
   }
   if (!joints_.empty()) {
     std::ofstream out(dir_ / "joints.csv");
-    if (!out) fail_reading(dir_ / "joints.csv", "cannot write");
+    if (!out) throw_file_error(dir_ / "joints.csv", "cannot write");
     out << header(true, hand_count_) << "\n";
     for (const auto& [frame, per_hand] : joints_) {
       out << frame;

@@ -139,8 +139,8 @@ TEST(HostileRecordings, MutantsNeverTakeTheDaemonDown) {
     mutations.push_back({std::uniform_int_distribution<std::size_t>(0, original.size() - 1)(rng), 0, true});
   }
 
-  // Four daemons play mutants at once, each with its own file and ring: a play is mostly waiting
-  // (OpenNI2 starting and shutting down its drivers in the helper), a fifth of it CPU.
+  // Four daemons play mutants at once, each with its own file and ring: a play waits on OpenNI2
+  // starting and shutting down its drivers in the helper, and the waits overlap.
   constexpr int kPlayers = 4;
   std::mutex mutex;
   std::map<Outcome, int> outcomes;
