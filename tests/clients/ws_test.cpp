@@ -321,15 +321,23 @@ TEST_F(WsBridge, ThePageDrawsTheMovingHandInChromium) {
       return decode_png(png);
     }
   };
-  std::this_thread::sleep_for(2s);  // the page connects and draws
-  const Rgb first = screenshot();
+  // The page draws once it has loaded, connected and received a pose; on a busy machine (the
+  // daemon loading its forest, Chromium starting) that takes seconds, so wait for it with a
+  // deadline rather than a fixed sleep.
+  Rgb first;
+  std::vector<int> a;
+  for (const auto deadline = std::chrono::steady_clock::now() + 30s;
+       a.size() <= 300U && std::chrono::steady_clock::now() < deadline;) {
+    std::this_thread::sleep_for(250ms);
+    first = screenshot();
+    a = hand_pixels(first);
+  }
+  ASSERT_GT(a.size(), 300U) << "no hand drawn within 30 s\n" << bridge->logs();
   std::this_thread::sleep_for(1s);
   const Rgb second = screenshot();
   ASSERT_GT(first.width, 0);
   ASSERT_EQ(first.width, second.width);
-  const auto a = hand_pixels(first);
   const auto b = hand_pixels(second);
-  EXPECT_GT(a.size(), 300U) << "no hand drawn in the first screenshot\n" << bridge->logs();
   EXPECT_GT(b.size(), 300U) << "no hand drawn in the second screenshot";
   std::vector<int> moved;
   std::set_symmetric_difference(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(moved));
