@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -18,6 +19,11 @@ constexpr size_t kFixedHeaderBytes = 36;  // magic .. metadata length
 constexpr size_t kChecksumBytes = 8;
 constexpr size_t kNodeBytes = 16;
 constexpr size_t kLeafBytes = 2 * kPartForestClasses;
+// A node in the file: u[0], u[1], v[0], v[1] (int16), threshold (float32), child (uint32); a leaf:
+// kPartForestClasses uint16 counts. In memory they are the same bytes.
+static_assert(sizeof(PartForestNode) == kNodeBytes && offsetof(PartForestNode, v) == 4 &&
+              offsetof(PartForestNode, threshold) == 8 && offsetof(PartForestNode, child) == 12);
+static_assert(sizeof(PartForestLeaf) == kLeafBytes);
 
 // FNV-1a 64 (Fowler, Noll, Vo): offset basis and prime of the 64-bit variant.
 constexpr uint64_t kFnvOffsetBasis = 0xcbf29ce484222325ULL;
@@ -96,31 +102,32 @@ std::string validate(const std::vector<PartForestTree>& trees, const PartForestI
   for (size_t t = 0; t < trees.size(); ++t) {
     const auto& nodes = trees[t].nodes;
     const auto& leaves = trees[t].leaves;
-    const std::string where = "tree " + std::to_string(t);
-    if (nodes.empty()) return where + ": no nodes";
-    if (nodes.size() > PartForest::kMaxNodesPerTree) return where + ": too many nodes";
-    if (leaves.size() > nodes.size()) return where + ": more leaves than nodes";
+    // The messages are built only for a node that fails: a forest has about a million nodes.
+    const auto where = [t] { return "tree " + std::to_string(t); };
+    const auto node = [&](size_t i) { return where() + " node " + std::to_string(i); };
+    if (nodes.empty()) return where() + ": no nodes";
+    if (nodes.size() > PartForest::kMaxNodesPerTree) return where() + ": too many nodes";
+    if (leaves.size() > nodes.size()) return where() + ": more leaves than nodes";
     for (size_t i = 0; i < nodes.size(); ++i) {
       const PartForestNode& n = nodes[i];
-      const std::string node = where + " node " + std::to_string(i);
       if (n.is_leaf()) {
         if (n.leaf_index() >= leaves.size()) {
-          return node + ": leaf index " + std::to_string(n.leaf_index()) + " out of range (" +
+          return node(i) + ": leaf index " + std::to_string(n.leaf_index()) + " out of range (" +
                  std::to_string(leaves.size()) + " leaves)";
         }
         continue;
       }
       // Children strictly after the parent: every path ends in a leaf within nodes.size() steps.
       if (n.child <= i || n.child >= nodes.size() - 1) {
-        return node + ": child index " + std::to_string(n.child) + " out of range (" + std::to_string(nodes.size()) +
-               " nodes)";
+        return node(i) + ": child index " + std::to_string(n.child) + " out of range (" +
+               std::to_string(nodes.size()) + " nodes)";
       }
-      if (!std::isfinite(n.threshold)) return node + ": threshold is not finite";
+      if (!std::isfinite(n.threshold)) return node(i) + ": threshold is not finite";
     }
     for (size_t l = 0; l < leaves.size(); ++l) {
       uint32_t sum = 0;
       for (const uint16_t p : leaves[l]) sum += p;
-      if (sum == 0) return where + " leaf " + std::to_string(l) + ": bad label distribution (all zero)";
+      if (sum == 0) return where() + " leaf " + std::to_string(l) + ": bad label distribution (all zero)";
     }
   }
   return {};
@@ -180,17 +187,8 @@ std::vector<uint8_t> PartForest::to_bytes() const {
     w.put(static_cast<uint32_t>(t.leaves.size()));
   }
   for (const auto& t : trees_) {
-    for (const auto& n : t.nodes) {
-      w.put(n.u[0]);
-      w.put(n.u[1]);
-      w.put(n.v[0]);
-      w.put(n.v[1]);
-      w.put(n.threshold);
-      w.put(n.child);
-    }
-    for (const auto& leaf : t.leaves) {
-      for (const uint16_t p : leaf) w.put(p);
-    }
+    w.put_bytes(t.nodes.data(), t.nodes.size() * kNodeBytes);
+    w.put_bytes(t.leaves.data(), t.leaves.size() * kLeafBytes);
   }
   const uint64_t checksum = fnv1a64(std::span<const uint8_t>(w.bytes().data(), w.pos()));
   w.put(checksum);
@@ -282,18 +280,11 @@ PartForest PartForest::from_bytes(std::span<const uint8_t> bytes, const std::str
       trees[t].nodes.resize(counts[t][0]);
       trees[t].leaves.resize(counts[t][1]);
     }
+    // Nodes and leaves are laid out in memory as in the file (the static_asserts above), so each
+    // tree's arrays are copied whole.
     for (auto& t : trees) {
-      for (auto& n : t.nodes) {
-        n.u[0] = r.read<int16_t>("node");
-        n.u[1] = r.read<int16_t>("node");
-        n.v[0] = r.read<int16_t>("node");
-        n.v[1] = r.read<int16_t>("node");
-        n.threshold = r.read<float>("node");
-        n.child = r.read<uint32_t>("node");
-      }
-      for (auto& leaf : t.leaves) {
-        for (auto& p : leaf) p = r.read<uint16_t>("leaf");
-      }
+      r.read_bytes(t.nodes.data(), t.nodes.size() * kNodeBytes, "nodes");
+      r.read_bytes(t.leaves.data(), t.leaves.size() * kLeafBytes, "leaves");
     }
     if (auto why = validate(trees, info); !why.empty()) throw fail(why);
     return PartForest(std::move(trees), std::move(info), options);
