@@ -166,8 +166,6 @@ class VirtualDeviceDaemon : public ::testing::Test {
   handtrack_client* client_ = nullptr;
 };
 
-}  // namespace
-
 TEST_F(VirtualDeviceDaemon, PublishesDeviceStatesAcrossUnplugAndReplug) {
   unplug();  // the daemon starts with no camera
   Daemon daemon(stage_, shm_);
@@ -219,3 +217,5 @@ TEST_F(VirtualDeviceDaemon, PublishesDeviceStatesAcrossUnplugAndReplug) {
   const std::string log = daemon.log();
   EXPECT_NE(log.find("handtrack-virtual://depth0"), std::string::npos) << log;
 }
+
+}  // namespace

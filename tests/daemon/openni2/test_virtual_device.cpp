@@ -98,8 +98,6 @@ class VirtualDevice : public ::testing::Test {
   void TearDown() override { plug(); }
 };
 
-}  // namespace
-
 TEST_F(VirtualDevice, StreamsDepthFramesWithIntrinsicsFromTheDevice) {
   auto source = make_source("openni2", SourceOptions{});
   EXPECT_TRUE(source->is_live());
@@ -302,6 +300,8 @@ TEST_F(VirtualDevice, TwoSourcesShareOneOpenNI2Runtime) {
   RawFrame frame;
   EXPECT_EQ(frames_within(*first, 3, 1s, frame), 3);
 }
+
+}  // namespace
 
 int main(int argc, char** argv) {
   if (const int status = handtrack::test::run_in_staged_openni2(argc, argv); status >= 0) return status;
