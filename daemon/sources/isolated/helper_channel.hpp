@@ -49,6 +49,10 @@ struct CameraReply {
 
 struct GrabRequest {
   std::int64_t timeout_ms = 0;
+  // The daemon's log level now (a spdlog::level::level_enum): a SIGHUP that changes
+  // daemon.log_level reaches the helper with its next grab.
+  std::int32_t log_level = 0;
+  std::int32_t reserved = 0;
 };
 
 struct FrameReply {  // followed by width * height uint16 pixels, row-major

@@ -114,7 +114,7 @@ class IsolatedSource final : public DepthSource {
       last_error_ = "not open";
       return live_ ? GrabStatus::kDisconnected : GrabStatus::kError;
     }
-    const GrabRequest request{timeout.count()};
+    const GrabRequest request{.timeout_ms = timeout.count(), .log_level = static_cast<std::int32_t>(log().level())};
     if (channel_.send(Kind::kGrab, &request, sizeof request) != Io::kOk) return failed(helper_ended("grabbing"));
     const std::int64_t deadline = monotonic_ns() + timeout.count() * 1'000'000 + kAnswerGraceNs;
     Header header;
@@ -161,7 +161,7 @@ class IsolatedSource final : public DepthSource {
     posix_spawnattr_setsigdefault(&attributes, &defaults);
     posix_spawnattr_setpgroup(&attributes, 0);
     posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETPGROUP);
-    // The helper logs at the daemon's level.
+    // The helper logs at the daemon's level: from its start, and as it changes (GrabRequest).
     const auto name = spdlog::level::to_string_view(log().level());
     std::string level(name.data(), name.size());
     char* argv[] = {const_cast<char*>(helper.c_str()), level.data(), nullptr};

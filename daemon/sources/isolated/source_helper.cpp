@@ -59,6 +59,13 @@ std::unique_ptr<DepthSource> open_source(Channel& channel, std::uint32_t payload
   return source;
 }
 
+// The daemon's level, sent with each grab (a SIGHUP may have changed it); anything else is ignored.
+void follow_log_level(std::int32_t level) {
+  if (level < spdlog::level::trace || level >= spdlog::level::n_levels) return;
+  const auto wanted = static_cast<spdlog::level::level_enum>(level);
+  if (log().level() != wanted) log().set_level(wanted);
+}
+
 void serve(Channel& channel) {
   std::unique_ptr<DepthSource> source;
   RawFrame frame;
@@ -76,6 +83,7 @@ void serve(Channel& channel) {
             channel.receive(&request, sizeof request, -1) != Io::kOk) {
           return;
         }
+        follow_log_level(request.log_level);
         const GrabStatus status = source->grab(frame, std::chrono::milliseconds(request.timeout_ms));
         if (status != GrabStatus::kFrame) {
           reply_status(channel, static_cast<int>(status), source->last_error());
@@ -100,7 +108,8 @@ int main(int argc, char** argv) {
   // camera. (A daemon gone before this line closed the socket: serve() returns at once.)
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);
   // OpenNI2's lines from here go to the daemon's stderr in the daemon's format, at the level the
-  // daemon had when it started this helper (argv[1], a spdlog level name).
+  // daemon had when it started this helper (argv[1], a spdlog level name), later the level each
+  // grab request carries.
   setup_logging(LogLevel::kInfo);
   if (argc > 1) log().set_level(spdlog::level::from_str(argv[1]));
   Channel channel(kChannelFd);

@@ -1,8 +1,10 @@
 // The real handtrackd on `--source openni2` against the virtual OpenNI2 camera: the device
 // states it publishes in the shared-memory header (read with the C client API) follow the
 // camera being plugged in, pulled and plugged in again, frames resume after each return, and the
-// daemon's threads and descriptors stay flat over the cycles. The daemon is driven only through
-// its command line and environment (LD_LIBRARY_PATH to the staged OpenNI2, see virtual_stage.hpp).
+// daemon's threads and descriptors stay flat over the cycles; a log level changed by SIGHUP reaches
+// the source helper that runs the camera. The daemon is driven only through its command line,
+// configuration file, signals and environment (LD_LIBRARY_PATH to the staged OpenNI2, see
+// virtual_stage.hpp).
 #include "virtual_stage.hpp"
 
 #include "handtrack/client.h"
@@ -49,9 +51,15 @@ std::string read_file(const fs::path& p) {
   return ss.str();
 }
 
+// handtrackd with `config` as its configuration file (stage/handtrackd.toml), at --log-level
+// `level` (none when empty: the file's).
 class Daemon {
  public:
-  Daemon(const std::string& stage, const std::string& shm) : stage_(stage), log_(fs::path(stage) / "handtrackd.log") {
+  Daemon(const std::string& stage, const std::string& shm, const std::string& config = "",
+         const std::string& level = "info")
+      : stage_(stage), log_(fs::path(stage) / "handtrackd.log") {
+    const std::string config_file = stage + "/handtrackd.toml";
+    std::ofstream(config_file) << config;
     pid_ = fork();
     if (pid_ == 0) {
       const int fd = ::open(log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -63,10 +71,11 @@ class Daemon {
       setenv("LD_LIBRARY_PATH", stage.c_str(), 1);
       setenv(handtrack::test::kPlugFileEnv, (stage + "/plugged").c_str(), 1);
       unsetenv("NOTIFY_SOCKET");
-      const std::string config = stage + "/none.toml";
-      std::ofstream(config) << "";
-      execl(HANDTRACKD_BINARY, HANDTRACKD_BINARY, "--source", "openni2", "--shm-name", shm.c_str(), "--config",
-            config.c_str(), "--log-level", "info", static_cast<char*>(nullptr));
+      std::vector<const char*> argv = {HANDTRACKD_BINARY, "--source", "openni2", "--shm-name", shm.c_str(),
+                                       "--config", config_file.c_str()};
+      if (!level.empty()) argv.insert(argv.end(), {"--log-level", level.c_str()});
+      argv.push_back(nullptr);
+      execv(HANDTRACKD_BINARY, const_cast<char* const*>(argv.data()));
       _exit(127);
     }
   }
@@ -81,6 +90,15 @@ class Daemon {
 
   [[nodiscard]] pid_t pid() const { return pid_; }
   [[nodiscard]] std::string log() const { return read_file(log_); }
+  // Waits for `text` in the log.
+  bool logged(const std::string& text, std::chrono::milliseconds within) const {
+    const auto end = Clock::now() + within;
+    for (;;) {
+      if (log().find(text) != std::string::npos) return true;
+      if (Clock::now() >= end) return false;
+      std::this_thread::sleep_for(20ms);
+    }
+  }
   [[nodiscard]] bool running() {
     if (reaped_) return false;
     int status = 0;
@@ -216,6 +234,29 @@ TEST_F(VirtualDeviceDaemon, PublishesDeviceStatesAcrossUnplugAndReplug) {
   EXPECT_EQ(daemon.stop(10s), 0) << daemon.log();
   const std::string log = daemon.log();
   EXPECT_NE(log.find("handtrack-virtual://depth0"), std::string::npos) << log;
+}
+
+// The camera runs in the source helper (a process of its own); a SIGHUP that raises
+// daemon.log_level from warn to info reaches the helper already running: its OpenNI2 line when the
+// camera is pulled ("device disconnected") appears, where before the reload its start-up lines did
+// not.
+TEST_F(VirtualDeviceDaemon, ASighupLogLevelReachesTheRunningHelper) {
+  const std::string at_warn = "[daemon]\nlog_level = \"warn\"\n";
+  plug();
+  Daemon daemon(stage_, shm_, at_warn, "");
+  ASSERT_TRUE(connect(daemon, 20s)) << "handtrackd never created its ring\n" << daemon.log();
+  ASSERT_GE(wait_state(HANDTRACK_DEVICE_STREAMING, 10s), 0) << daemon.log();
+  ASSERT_TRUE(frames_grow(5, 8s)) << daemon.log();
+  EXPECT_EQ(daemon.log().find("info: OpenNI2"), std::string::npos) << "the helper logs below warn\n" << daemon.log();
+
+  std::ofstream(stage_ + "/handtrackd.toml") << "[daemon]\nlog_level = \"info\"\n";
+  ASSERT_EQ(kill(daemon.pid(), SIGHUP), 0);
+  ASSERT_TRUE(daemon.logged("SIGHUP: configuration reloaded", 10s)) << daemon.log();
+  ASSERT_TRUE(frames_grow(5, 8s)) << "the helper's grabs carry the new level\n" << daemon.log();
+  unplug();
+  ASSERT_GE(wait_state(HANDTRACK_DEVICE_WAITING_FOR_DEVICE, 5s), 0) << daemon.log();
+  EXPECT_TRUE(daemon.logged("info: OpenNI2: device disconnected", 5s)) << daemon.log();
+  EXPECT_EQ(daemon.stop(10s), 0) << daemon.log();
 }
 
 }  // namespace
