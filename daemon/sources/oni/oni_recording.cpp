@@ -84,9 +84,9 @@ class OniRecording final : public OpenNi2SourceBase {
     if (!open_depth_stream(why)) return false;
     last_frame_ns_ = monotonic_ns();
     log().info("{}: {} depth frames {}x{} at {} fps, f {:.1f}/{:.1f} px, depth unit {} mm{}{}", describe(),
-                   frame_count_, camera_.width, camera_.height, camera_.fps, camera_.fx, camera_.fy,
-                   camera_.depth_scale_mm, options_.loop ? ", looped" : "",
-                   options_.as_fast_as_possible ? ", as fast as possible" : "");
+               frame_count_, camera_.width, camera_.height, camera_.fps, camera_.fx, camera_.fy,
+               camera_.depth_scale_mm, options_.loop ? ", looped" : "",
+               options_.as_fast_as_possible ? ", as fast as possible" : "");
     return true;
   }
 

@@ -108,7 +108,7 @@ class OpenNi2Camera final : public OpenNi2SourceBase {
     open_uri_ = chosen;
     last_frame_ns_ = monotonic_ns();
     log().info("{}: opened {} ({}x{} at {} fps, f {:.1f}/{:.1f} px, depth unit {} mm)", describe(), chosen,
-                   camera_.width, camera_.height, camera_.fps, camera_.fx, camera_.fy, camera_.depth_scale_mm);
+               camera_.width, camera_.height, camera_.fps, camera_.fx, camera_.fy, camera_.depth_scale_mm);
     return true;
   }
 
@@ -145,7 +145,7 @@ class OpenNi2Camera final : public OpenNi2SourceBase {
       }
     } else if (!mode) {
       log().warn("{}: neither {}x{}@{} nor {}x{}@{} is offered; keeping the sensor's mode", describe(),
-                     options_.width, options_.height, options_.fps, kFallbackWidth, kFallbackHeight, kFallbackFps);
+                 options_.width, options_.height, options_.fps, kFallbackWidth, kFallbackHeight, kFallbackFps);
     }
     if (stream_->isPropertySupported(openni::STREAM_PROPERTY_MIRRORING) && stream_->getMirroringEnabled() &&
         stream_->setMirroringEnabled(false) != openni::STATUS_OK) {
