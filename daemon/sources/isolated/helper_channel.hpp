@@ -38,7 +38,7 @@ struct OpenRequest {  // followed by the source spec (oni:FILE, openni2:URI)
   std::int32_t width = 0;
   std::int32_t height = 0;
   std::int32_t fps = 0;
-  std::int32_t reserved = 0;
+  std::int32_t log_level = 0;  // see GrabRequest
 };
 
 struct CameraReply {
@@ -49,8 +49,8 @@ struct CameraReply {
 
 struct GrabRequest {
   std::int64_t timeout_ms = 0;
-  // The daemon's log level now (a spdlog::level::level_enum): a SIGHUP that changes
-  // daemon.log_level reaches the helper with its next grab.
+  // The daemon's log level now (a spdlog::level::level_enum), as in every request: the helper logs
+  // at it, and a SIGHUP that changes daemon.log_level reaches the helper with its next grab.
   std::int32_t log_level = 0;
   std::int32_t reserved = 0;
 };

@@ -161,10 +161,7 @@ class IsolatedSource final : public DepthSource {
     posix_spawnattr_setsigdefault(&attributes, &defaults);
     posix_spawnattr_setpgroup(&attributes, 0);
     posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETPGROUP);
-    // The helper logs at the daemon's level: from its start, and as it changes (GrabRequest).
-    const auto name = spdlog::level::to_string_view(log().level());
-    std::string level(name.data(), name.size());
-    char* argv[] = {const_cast<char*>(helper.c_str()), level.data(), nullptr};
+    char* argv[] = {const_cast<char*>(helper.c_str()), nullptr};
     const int rc = ::posix_spawn(&pid_, helper.c_str(), &actions, &attributes, argv, environ);
     posix_spawn_file_actions_destroy(&actions);
     posix_spawnattr_destroy(&attributes);
@@ -181,7 +178,7 @@ class IsolatedSource final : public DepthSource {
 
   bool start_source(std::string* why) {
     const OpenRequest request{options_.loop ? 1 : 0, options_.as_fast_as_possible ? 1 : 0, options_.width,
-                              options_.height, options_.fps, 0};
+                              options_.height, options_.fps, static_cast<std::int32_t>(log().level())};
     if (channel_.send(Kind::kOpen, &request, sizeof request, spec_.data(), spec_.size()) != Io::kOk) {
       *why = name_ + ": " + helper_ended("opening");
       return false;

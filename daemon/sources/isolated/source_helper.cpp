@@ -28,6 +28,14 @@ void reply_status(Channel& channel, int status, const std::string& text) {
   channel.send(Kind::kStatus, &reply, sizeof reply, clipped.data(), clipped.size());
 }
 
+// The daemon's log level, which every request carries (a SIGHUP may have changed it); anything
+// else is ignored.
+void follow_log_level(std::int32_t level) {
+  if (level >= spdlog::level::trace && level < spdlog::level::n_levels) {
+    log().set_level(static_cast<spdlog::level::level_enum>(level));
+  }
+}
+
 std::unique_ptr<DepthSource> open_source(Channel& channel, std::uint32_t payload) {
   OpenRequest request;
   std::string spec;
@@ -35,6 +43,7 @@ std::unique_ptr<DepthSource> open_source(Channel& channel, std::uint32_t payload
       channel.receive_text(&spec, payload - sizeof request, -1) != Io::kOk) {
     return nullptr;
   }
+  follow_log_level(request.log_level);
   SourceOptions options;
   options.loop = request.loop != 0;
   options.as_fast_as_possible = request.as_fast_as_possible != 0;
@@ -57,13 +66,6 @@ std::unique_ptr<DepthSource> open_source(Channel& channel, std::uint32_t payload
   const CameraReply reply{cam.width, cam.height, cam.fx, cam.fy, cam.cx, cam.cy, cam.depth_scale_mm, cam.fps};
   channel.send(Kind::kOpened, &reply, sizeof reply);
   return source;
-}
-
-// The daemon's level, sent with each grab (a SIGHUP may have changed it); anything else is ignored.
-void follow_log_level(std::int32_t level) {
-  if (level < spdlog::level::trace || level >= spdlog::level::n_levels) return;
-  const auto wanted = static_cast<spdlog::level::level_enum>(level);
-  if (log().level() != wanted) log().set_level(wanted);
 }
 
 void serve(Channel& channel) {
@@ -103,15 +105,13 @@ void serve(Channel& channel) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main() {
   // Die with the daemon even when a driver hangs: a helper must never outlive it holding the
   // camera. (A daemon gone before this line closed the socket: serve() returns at once.)
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-  // OpenNI2's lines from here go to the daemon's stderr in the daemon's format, at the level the
-  // daemon had when it started this helper (argv[1], a spdlog level name), later the level each
-  // grab request carries.
+  // OpenNI2's lines go to the daemon's stderr in the daemon's format, at the level each request
+  // carries (follow_log_level).
   setup_logging(LogLevel::kInfo);
-  if (argc > 1) log().set_level(spdlog::level::from_str(argv[1]));
   Channel channel(kChannelFd);
   serve(channel);
   return 0;
