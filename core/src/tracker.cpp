@@ -17,53 +17,9 @@ namespace {
 constexpr int kTrialRestartFrames = 5;
 // Pinch strength falls from 1 (tips touching) to 0 at this surface distance.
 constexpr double kPinchOpenMm = 40.0;
-
-// The value among `values` whose to_string() is `text`.
-template <typename Enum>
-bool parse_name(const std::string& text, std::initializer_list<Enum> values, Enum* out) {
-  for (Enum v : values) {
-    if (text == to_string(v)) {
-      *out = v;
-      return true;
-    }
-  }
-  return false;
-}
 }  // namespace
 
 double TrackerOutput::score() const { return fit_score(confidence, label_agreement); }
-
-const char* to_string(EnergyMode mode) {
-  return mode == EnergyMode::kLateFusion ? "late-fusion" : "depth-only";
-}
-
-bool parse_energy_mode(const std::string& text, EnergyMode* mode) {
-  return parse_name(text, {EnergyMode::kLateFusion, EnergyMode::kDepthOnly}, mode);
-}
-
-const char* to_string(TrackingState state) {
-  switch (state) {
-    case TrackingState::kNoHand: return "no_hand";
-    case TrackingState::kTracking: return "tracking";
-    case TrackingState::kRecovering: return "recovering";
-  }
-  return "?";
-}
-
-const char* to_string(Handedness hand) { return hand == Handedness::kLeft ? "left" : "right"; }
-
-const char* to_string(HandednessMode mode) {
-  switch (mode) {
-    case HandednessMode::kRight: return "right";
-    case HandednessMode::kLeft: return "left";
-    case HandednessMode::kAuto: return "auto";
-  }
-  return "?";
-}
-
-bool parse_handedness_mode(const std::string& text, HandednessMode* mode) {
-  return parse_name(text, {HandednessMode::kAuto, HandednessMode::kLeft, HandednessMode::kRight}, mode);
-}
 
 namespace {
 

@@ -1,0 +1,57 @@
+// The names of the tracker's modes and states, as the configuration and the outputs spell them
+// (tracker.hpp). Apart from the tracker, in handtrack::core_files: handtrackd's configuration
+// parser uses them, and the fuzz tree builds that parser without the tracker (tests/fuzz).
+#include "handtrack/core/tracker.hpp"
+
+#include <initializer_list>
+#include <string>
+
+namespace handtrack {
+
+namespace {
+// The value among `values` whose to_string() is `text`.
+template <typename Enum>
+bool parse_name(const std::string& text, std::initializer_list<Enum> values, Enum* out) {
+  for (Enum v : values) {
+    if (text == to_string(v)) {
+      *out = v;
+      return true;
+    }
+  }
+  return false;
+}
+}  // namespace
+
+const char* to_string(EnergyMode mode) {
+  return mode == EnergyMode::kLateFusion ? "late-fusion" : "depth-only";
+}
+
+bool parse_energy_mode(const std::string& text, EnergyMode* mode) {
+  return parse_name(text, {EnergyMode::kLateFusion, EnergyMode::kDepthOnly}, mode);
+}
+
+const char* to_string(TrackingState state) {
+  switch (state) {
+    case TrackingState::kNoHand: return "no_hand";
+    case TrackingState::kTracking: return "tracking";
+    case TrackingState::kRecovering: return "recovering";
+  }
+  return "?";
+}
+
+const char* to_string(Handedness hand) { return hand == Handedness::kLeft ? "left" : "right"; }
+
+const char* to_string(HandednessMode mode) {
+  switch (mode) {
+    case HandednessMode::kRight: return "right";
+    case HandednessMode::kLeft: return "left";
+    case HandednessMode::kAuto: return "auto";
+  }
+  return "?";
+}
+
+bool parse_handedness_mode(const std::string& text, HandednessMode* mode) {
+  return parse_name(text, {HandednessMode::kAuto, HandednessMode::kLeft, HandednessMode::kRight}, mode);
+}
+
+}  // namespace handtrack
