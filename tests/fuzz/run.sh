@@ -12,7 +12,7 @@ case "$job" in
     src="$2" dir="$3"
     if [ ! -f "$dir/CMakeCache.txt" ]; then
       # A unity build with line tables only (-g1, enough for the sanitizers' stacks).
-      CC=clang CXX=clang++ cmake -S "$src" -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+      CC=clang CXX=clang++ cmake -S "$src" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
         -DHANDTRACK_SANITIZE=fuzz -DHANDTRACK_WERROR=OFF -DCMAKE_UNITY_BUILD=ON \
         "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG" >/dev/null
     fi

@@ -9,7 +9,7 @@ job="$1" dir="$2"
 case "$job" in
   build)
     if [ ! -f "$dir/CMakeCache.txt" ]; then
-      CC=clang CXX=clang++ cmake -S "$here" -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+      CC=clang CXX=clang++ cmake -S "$here" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
     fi
     cmake --build "$dir" -j"${HANDTRACK_JOBS:-2}" ;;
   tsan)
