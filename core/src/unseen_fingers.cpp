@@ -35,24 +35,30 @@ UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous
   const Eigen::Matrix3d r = hand_rotation(previous);
   const double facing = r.col(2).z() * r.col(2).z();
   const double across_view = facing * (1.0 - std::abs(r.col(1).z()));
+  const double from_behind = std::max(0.0, r.col(2).z()) * std::max(0.0, r.col(1).z());
   for (int f = kIndex; f < kNumFingers; ++f) {
     const double share = static_cast<double>(seen[static_cast<size_t>(f)]) / labelled;
     unseen.weight[static_cast<size_t>(f)] = across_view * (1.0 - std::min(1.0, share / kSeenFingerShare));
+    unseen.held[static_cast<size_t>(f)] = from_behind;
   }
   return unseen;
 }
 
 double unseen_finger_energy(const UnseenFingers& unseen, const PoseParams& params, PoseGradient* gradient) {
   double energy = 0.0;
-  for (int f = kIndex; f < kNumFingers; ++f) {
-    const double u = unseen.weight[static_cast<size_t>(f)];
-    if (u == 0.0) continue;
+  // One finger's sum_d w (theta_{f,d} - target_d)^2 and its gradient.
+  const auto pull = [&](int f, double w, const auto& target) {
+    if (w == 0.0) return;
     for (int d = 1; d <= 3; ++d) {
       const int j = angle_param(f, d);
-      const double a = params[j] - kCurledFlexion[static_cast<size_t>(d - 1)];
-      energy += u * a * a;
-      if (gradient != nullptr) (*gradient)[j] += 2.0 * u * a;
+      const double a = params[j] - target(d);
+      energy += w * a * a;
+      if (gradient != nullptr) (*gradient)[j] += 2.0 * w * a;
     }
+  };
+  for (int f = kIndex; f < kNumFingers; ++f) {
+    pull(f, unseen.weight[static_cast<size_t>(f)], [](int d) { return kCurledFlexion[static_cast<size_t>(d - 1)]; });
+    pull(f, unseen.held[static_cast<size_t>(f)], [](int /*d*/) { return kHalfCurlFlexion; });
   }
   return energy;
 }

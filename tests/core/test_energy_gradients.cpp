@@ -190,9 +190,10 @@ TEST_P(EnergyGradient, EveryTermMatchesFiniteDifferences) {
       [&](const PoseParams& p, PoseGradient* g) { return total_free.evaluate(seen_frame, p, hand, g); }, pose,
       "E with E_free");
 
-  // E_unseen, alone and in E, with a weight on every finger it acts on.
+  // E_unseen, alone and in E, with both weights on every finger they act on.
   UnseenFingers unseen;
   unseen.weight = {0.0, 0.3, 0.6, 0.9, 1.0};
+  unseen.held = {0.0, 0.4, 0.1, 0.2, 0.38};
   EXPECT_GT(unseen_finger_energy(unseen, pose, nullptr), 1e-3);
   expect_gradient_matches([&](const PoseParams& p, PoseGradient* g) { return unseen_finger_energy(unseen, p, g); },
                           pose, "E_unseen");
@@ -251,6 +252,8 @@ TEST(EnergyTerms, SimilarityPeaksWhenModelSitsOnItsOwnImage) {
 // u_f (unseen_fingers.hpp): 1 for a finger the labels do not see on a hand whose palm faces the
 // camera with the fingers across the view, 0 for a finger in full view, for the thumb, for a hand
 // seen edge-on or pointing at the camera, and without labels; E_unseen is 0 at the curled pose.
+// h_f: n_z a_z on every finger but the thumb, seen or not, for a hand seen from behind with its
+// fingers pointing away; 0 otherwise.
 TEST(EnergyTerms, UnseenFingersAreTheFingersTheLabelsMissOnAHandFacingTheCamera) {
   DepthInput input;
   const auto label = [&](int part, int pixels) { input.pixel_labels.insert(input.pixel_labels.end(), pixels, part); };
@@ -277,8 +280,25 @@ TEST(EnergyTerms, UnseenFingersAreTheFingersTheLabelsMissOnAHandFacingTheCamera)
   EXPECT_NEAR(edge_on[kRing], 0.0, 1e-9);
   const auto pointing = weights(Eigen::Vector3d(std::numbers::pi / 2, 0, 0));  // fingers along the view
   EXPECT_NEAR(pointing[kRing], 0.0, 1e-9);
+
+  const auto held = [&](const Eigen::Vector3d& rotation) {
+    PoseParams pose = PoseParams::Zero();
+    pose.segment<3>(kRotationParam) = rotation;
+    return unseen_fingers(input, pose).held;
+  };
+  // The head-mounted view: turned 115 deg about the camera's x axis, the back of the hand toward the
+  // camera (n_z = cos 65 deg) and the fingers pointing away from it (a_z = sin 65 deg).
+  const double tipped = -(std::numbers::pi / 2 + 25.0 * std::numbers::pi / 180.0);
+  const auto from_behind = held(Eigen::Vector3d(tipped, 0, 0));
+  const double expected = std::cos(65.0 * std::numbers::pi / 180.0) * std::sin(65.0 * std::numbers::pi / 180.0);
+  EXPECT_EQ(from_behind[kThumb], 0.0);
+  for (const int f : {kIndex, kMiddle, kRing, kLittle}) EXPECT_NEAR(from_behind[f], expected, 1e-9) << f;
+  EXPECT_NEAR(held(Eigen::Vector3d::Zero())[kRing], 0.0, 1e-9);                         // palm toward
+  EXPECT_NEAR(held(Eigen::Vector3d(0, std::numbers::pi, 0))[kRing], 0.0, 1e-9);         // back, fingers up
+  EXPECT_NEAR(held(Eigen::Vector3d(-tipped, 0, 0))[kRing], 0.0, 1e-9);                  // fingers toward it
   input.pixel_labels.clear();
   EXPECT_EQ(weights(Eigen::Vector3d::Zero())[kRing], 0.0);
+  EXPECT_EQ(held(Eigen::Vector3d(tipped, 0, 0))[kRing], 0.0);
 
   UnseenFingers unseen;
   unseen.weight[kRing] = 1.0;
@@ -286,6 +306,12 @@ TEST(EnergyTerms, UnseenFingersAreTheFingersTheLabelsMissOnAHandFacingTheCamera)
   for (int d = 1; d <= 3; ++d) curled[angle_param(kRing, d)] = kCurledFlexion[static_cast<size_t>(d - 1)];
   EXPECT_EQ(unseen_finger_energy(unseen, curled, nullptr), 0.0);
   EXPECT_NEAR(unseen_finger_energy(unseen, PoseParams::Zero(), nullptr), 1.3 * 1.3 + 1.6 * 1.6 + 0.9 * 0.9, 1e-12);
+  UnseenFingers behind;
+  behind.held[kRing] = 0.5;
+  PoseParams half = PoseParams::Zero();
+  for (int d = 1; d <= 3; ++d) half[angle_param(kRing, d)] = kHalfCurlFlexion;
+  EXPECT_EQ(unseen_finger_energy(behind, half, nullptr), 0.0);
+  EXPECT_NEAR(unseen_finger_energy(behind, PoseParams::Zero(), nullptr), 0.5 * 3 * 0.6 * 0.6, 1e-12);
 }
 
 TEST(EnergyTerms, JointLimitIsZeroInsideAndQuadraticOutside) {

@@ -25,6 +25,21 @@
 // gradient. The thumb is left out (its curl is not a fist's; not measured with it). Late fusion
 // only (labels), only while tracking (a previous pose), and not beside another hand (it can hide
 // an outstretched finger too).
+//
+// Seen from behind along the fingers (a head-mounted camera over a hand reaching forward: the back
+// of the hand toward the camera, the fingers pointing away from it) the fingers are behind the
+// knuckles whatever their flexion, and the labels cannot say how far they are curled. There
+// E_sim pays a finger for curling toward the visible back of the hand, and fingers that were
+// extended were fitted curled into a fist (docs/TRACKER.md, "The head-mounted view taken apart").
+// So there every finger is also held at a half curl, whatever the labels see:
+//
+//   E_unseen += sum_f h_f sum_{d = 1..3} (theta_{f,d} - theta^half)^2,   h_f = max(0, n_z) max(0, a_z)
+//
+// (n_z > 0: the back of the hand toward the camera; a_z > 0: the fingers pointing away from it;
+// at the head-mounted view's 65 deg, h_f = 0.38; 0 with the palm toward the camera or the fingers
+// across the view). theta^half = 0.6 rad and the weight were chosen on ten head-mounted sequences
+// of seeds 1-2 and measured on the whole benchmark of seeds 1-9 (docs/TRACKER.md, "Fingers seen
+// from behind hold a half curl").
 
 #include "handtrack/core/depth_input.hpp"
 #include "handtrack/core/hand_layout.hpp"
@@ -38,14 +53,18 @@ namespace handtrack {
 inline constexpr std::array<double, 3> kCurledFlexion = {1.3, 1.6, 0.9};
 // s_0: a finger whose parts hold this share of the labelled hand pixels counts as fully seen.
 inline constexpr double kSeenFingerShare = 0.04;
+// theta^half: the flexion (each of flex1..flex3, radians) at which fingers seen from behind along
+// their length are held.
+inline constexpr double kHalfCurlFlexion = 0.6;
 
-// u_f of one frame (0 for the thumb).
+// u_f and h_f of one frame (0 for the thumb).
 struct UnseenFingers {
-  std::array<double, kNumFingers> weight{};
+  std::array<double, kNumFingers> weight{};  // u_f, toward the relaxed fist
+  std::array<double, kNumFingers> held{};    // h_f, toward the half curl
 };
 
-// u_f from the frame's part labels and the previous pose (only its global rotation is read); all 0
-// without labels.
+// u_f from the frame's part labels and the previous pose, h_f from the previous pose (only its
+// global rotation is read); all 0 without labels.
 UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous);
 
 // E_unseen at `params`; adds dE_unseen/dTheta into *gradient when not null.
