@@ -47,18 +47,18 @@ UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous
 double unseen_finger_energy(const UnseenFingers& unseen, const PoseParams& params, PoseGradient* gradient) {
   double energy = 0.0;
   // One finger's sum_d w (theta_{f,d} - target_d)^2 and its gradient.
-  const auto pull = [&](int f, double w, const auto& target) {
+  const auto pull = [&](int f, double w, const std::array<double, 3>& target) {
     if (w == 0.0) return;
     for (int d = 1; d <= 3; ++d) {
       const int j = angle_param(f, d);
-      const double a = params[j] - target(d);
+      const double a = params[j] - target[static_cast<size_t>(d - 1)];
       energy += w * a * a;
       if (gradient != nullptr) (*gradient)[j] += 2.0 * w * a;
     }
   };
   for (int f = kIndex; f < kNumFingers; ++f) {
-    pull(f, unseen.weight[static_cast<size_t>(f)], [](int d) { return kCurledFlexion[static_cast<size_t>(d - 1)]; });
-    pull(f, unseen.held[static_cast<size_t>(f)], [](int /*d*/) { return kHalfCurlFlexion; });
+    pull(f, unseen.weight[static_cast<size_t>(f)], kCurledFlexion);
+    pull(f, unseen.held[static_cast<size_t>(f)], kHalfCurlFlexion);
   }
   return energy;
 }

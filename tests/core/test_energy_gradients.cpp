@@ -263,11 +263,14 @@ TEST(EnergyTerms, UnseenFingersAreTheFingersTheLabelsMissOnAHandFacingTheCamera)
   label(part_label(kMiddle, 2), 80);
   label(part_label(kLittle, 1), 20);  // 2 % of the labelled pixels: half seen
   label(kBackground, 500);            // not counted
-  const auto weights = [&](const Eigen::Vector3d& rotation) {
+  // u_f and h_f for a previous pose turned by `rotation`.
+  const auto fingers = [&](const Eigen::Vector3d& rotation) {
     PoseParams pose = PoseParams::Zero();
     pose.segment<3>(kRotationParam) = rotation;
-    return unseen_fingers(input, pose).weight;
+    return unseen_fingers(input, pose);
   };
+  const auto weights = [&](const Eigen::Vector3d& rotation) { return fingers(rotation).weight; };
+  const auto held = [&](const Eigen::Vector3d& rotation) { return fingers(rotation).held; };
   const auto facing = weights(Eigen::Vector3d::Zero());  // palm toward the camera, fingers up
   EXPECT_EQ(facing[kThumb], 0.0);
   EXPECT_EQ(facing[kIndex], 0.0);
@@ -281,11 +284,6 @@ TEST(EnergyTerms, UnseenFingersAreTheFingersTheLabelsMissOnAHandFacingTheCamera)
   const auto pointing = weights(Eigen::Vector3d(std::numbers::pi / 2, 0, 0));  // fingers along the view
   EXPECT_NEAR(pointing[kRing], 0.0, 1e-9);
 
-  const auto held = [&](const Eigen::Vector3d& rotation) {
-    PoseParams pose = PoseParams::Zero();
-    pose.segment<3>(kRotationParam) = rotation;
-    return unseen_fingers(input, pose).held;
-  };
   // The head-mounted view: turned 115 deg about the camera's x axis, the back of the hand toward the
   // camera (n_z = cos 65 deg) and the fingers pointing away from it (a_z = sin 65 deg).
   const double tipped = -(std::numbers::pi / 2 + 25.0 * std::numbers::pi / 180.0);
@@ -309,7 +307,7 @@ TEST(EnergyTerms, UnseenFingersAreTheFingersTheLabelsMissOnAHandFacingTheCamera)
   UnseenFingers behind;
   behind.held[kRing] = 0.5;
   PoseParams half = PoseParams::Zero();
-  for (int d = 1; d <= 3; ++d) half[angle_param(kRing, d)] = kHalfCurlFlexion;
+  for (int d = 1; d <= 3; ++d) half[angle_param(kRing, d)] = kHalfCurlFlexion[static_cast<size_t>(d - 1)];
   EXPECT_EQ(unseen_finger_energy(behind, half, nullptr), 0.0);
   EXPECT_NEAR(unseen_finger_energy(behind, PoseParams::Zero(), nullptr), 0.5 * 3 * 0.6 * 0.6, 1e-12);
 }

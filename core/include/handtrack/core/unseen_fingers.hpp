@@ -53,9 +53,9 @@ namespace handtrack {
 inline constexpr std::array<double, 3> kCurledFlexion = {1.3, 1.6, 0.9};
 // s_0: a finger whose parts hold this share of the labelled hand pixels counts as fully seen.
 inline constexpr double kSeenFingerShare = 0.04;
-// theta^half: the flexion (each of flex1..flex3, radians) at which fingers seen from behind along
-// their length are held.
-inline constexpr double kHalfCurlFlexion = 0.6;
+// theta^half: the flexion (flex1..flex3, radians) at which fingers seen from behind along their
+// length are held.
+inline constexpr std::array<double, 3> kHalfCurlFlexion = {0.6, 0.6, 0.6};
 
 // u_f and h_f of one frame (0 for the thumb).
 struct UnseenFingers {
