@@ -197,15 +197,16 @@ TEST_F(WsBridge, ASlowClientSlowsNeitherTheDaemonNorTheOthers) {
   handtrack_client* ring = nullptr;
   ASSERT_EQ(handtrack_open(bridge->shm_name().c_str(), &ring), HANDTRACK_OK);
   ASSERT_EQ(handtrack_rewind(ring), HANDTRACK_OK);
-  uint64_t oldest = 0;
+  std::optional<uint64_t> oldest;
   int published = 0;
   handtrack_frame frame{};
   while (handtrack_wait_next(ring, &frame, 0) == HANDTRACK_OK) {
-    if (oldest == 0) oldest = frame.frame;
+    if (!oldest) oldest = frame.frame;
     published += frame.frame >= first_frame && frame.frame <= last_frame ? 1 : 0;
   }
   handtrack_close(ring);
-  ASSERT_LE(oldest, first_frame) << "the ring no longer holds the window's first pose";
+  ASSERT_TRUE(oldest.has_value()) << "the ring holds no pose";
+  ASSERT_LE(*oldest, first_frame) << "the ring no longer holds the window's first pose";
   ASSERT_GT(published, 10) << "the window saw poses at all";
   std::cout << "beside a stalled client: " << received << " of the " << published << " poses published ("
             << last_frame - first_frame + 1 << " frames captured)\n";
