@@ -197,7 +197,11 @@ void posed_primitives(const HandShape& shape, const HandPose& pose, const Joints
     }
   }
   for (const auto& c : shape.palm) out.push_back(to_camera(c));
-  out.push_back(to_camera(shape.forearm));
+  ConeSphere forearm = to_camera(shape.forearm);
+  if (shape.forearm_camera_direction) {
+    forearm.b = forearm.a + (shape.forearm.b - shape.forearm.a).norm() * *shape.forearm_camera_direction;
+  }
+  out.push_back(forearm);
 }
 
 void place_palm(HandPose& pose, const HandShape& shape, const Eigen::Matrix3d& turn, const Vector3d& palm_centre_mm) {

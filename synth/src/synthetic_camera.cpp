@@ -219,9 +219,9 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
     }
     options.subject = subjects[0];
   }
-  state_ = std::make_unique<State>(std::move(options), std::array<HandShape, kTwoHands>{
-                                                           HandShape::for_subject(subjects[0]),
-                                                           HandShape::for_subject(subjects[1])});
+  const std::array<HandShape, kTwoHands> shapes{view_shape(options.view, HandShape::for_subject(subjects[0])),
+                                                 HandShape::for_subject(subjects[1])};
+  state_ = std::make_unique<State>(std::move(options), shapes);
   State& s = *state_;
   std::vector<PlanePatch> planes;
   std::vector<ConeSphere> background_solids;

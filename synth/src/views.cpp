@@ -69,4 +69,11 @@ HandPose view_pose(View view, const HandPose& pose, const HandShape& shape) {
   return out;
 }
 
+HandShape view_shape(View view, HandShape shape) {
+  // Head-mounted: from the wrist down toward the image bottom and 53 deg from the image plane
+  // toward the camera (12 deg from the straight wrist at the arrangement's rest pose).
+  if (view == View::kHeadMounted) shape.forearm_camera_direction = Vector3d(0.0, 0.6, -0.8);
+  return shape;
+}
+
 }  // namespace handtrack::synth

@@ -593,6 +593,46 @@ TEST(SynthViews, EachViewTurnsThePoseAsItsNameSays) {
   EXPECT_FALSE(parse_view("top"));
 }
 
+// A head-mounted camera sees the forearm come up from the image bottom, as a real one does, and
+// never in front of the hand or at the lens, whatever a motion does with the hand: in every 10th
+// frame of every motion, for three subjects, the bottom row shows the forearm, the hand keeps 700
+// pixels (a hand at 330 mm has 1,000-3,000) and no pixel of the forearm is nearer than 120 mm.
+// (Rigid in the hand frame, the forearm pointed at the lens as the motions rolled the hand, and
+// hid the hand, or the whole image, at the ends of sequences: views.hpp, view_shape.)
+TEST(SynthViews, AHeadMountedForearmComesFromTheImageBottomAndNeverHidesTheHand) {
+  for (const std::string_view motion : kMotionNames) {
+    for (const uint64_t seed : {1, 2, 3}) {
+      SynthOptions o = clean_options(std::string(motion), Background::kTable);
+      o.view = View::kHeadMounted;
+      o.seed = seed;
+      o.noise_params.min_range_mm = 1.0;  // the forearm wherever it is
+      SyntheticCamera cam(o);
+      for (int i = 0; i < o.frames; i += 10) {
+        SCOPED_TRACE(std::string(motion) + " seed " + std::to_string(seed) + " frame " + std::to_string(i));
+        const SynthFrame f = cam.render(i);
+        const int w = f.depth.width();
+        const double wrist_z = f.joints[handtrack::kWristJoint].z();
+        int hand = 0;
+        int forearm_at_bottom = 0;
+        float nearest_forearm = std::numeric_limits<float>::infinity();
+        for (size_t k = 0; k < f.labels.pixels.size(); ++k) {
+          const float z = f.depth.depth_mm[k];
+          if (z <= 0.0F) continue;
+          if (f.labels.pixels[k] != 0) {
+            ++hand;
+          } else if (z < wrist_z) {  // nearer than the wrist: the forearm, not the table
+            nearest_forearm = std::min(nearest_forearm, z);
+            forearm_at_bottom += k >= f.labels.pixels.size() - static_cast<size_t>(w) ? 1 : 0;
+          }
+        }
+        EXPECT_GE(hand, 700) << "the hand is in view";
+        EXPECT_GE(forearm_at_bottom, 30) << "the forearm comes up from the image bottom";
+        EXPECT_GE(nearest_forearm, 120.0F) << "the forearm stays away from the lens";
+      }
+    }
+  }
+}
+
 }  // namespace
 
 // Two hands at once (issue 14): a right and a left hand in one z-buffered image, each with its own

@@ -25,6 +25,7 @@
 #include <Eigen/Geometry>  // cross()
 
 #include <array>
+#include <optional>
 #include <vector>
 
 namespace handtrack::synth {
@@ -92,6 +93,10 @@ struct HandShape {
   std::array<FingerShape, kNumFingers> fingers{};
   std::vector<ConeSphere> palm;  // rigid in the hand frame, label kPalm (includes the wrist region)
   ConeSphere forearm;            // rigid in the hand frame, label 0
+  // When set, the forearm leaves its start (forearm.a, still rigid in the hand frame) along this
+  // unit direction of the camera frame, whatever the hand's rotation: the wrist bends, and the
+  // elbow stays where the arrangement puts it (the head-mounted view: views.hpp, view_shape).
+  std::optional<Eigen::Vector3d> forearm_camera_direction;
   Eigen::Vector3d palm_centre_mm = Eigen::Vector3d::Zero();  // hand frame; motions orbit around it
 
   // The mean adult right hand (scale 1.0) of the module brief.

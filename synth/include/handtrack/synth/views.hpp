@@ -11,8 +11,9 @@
 //   fingers-away    the fingers tipped 50 deg away from it (the forearm comes nearer)
 //   head-mounted    an egocentric camera behind and above a hand reaching forward: the back of
 //                   the hand toward the camera, the fingers 65 deg away from it, the palm centre
-//                   330 mm away, the forearm entering from the image bottom through the near
-//                   plane (150 mm), a table below
+//                   330 mm away, the forearm coming up from below the camera into the image
+//                   bottom (its nearest pixels 120-240 mm away, about the working volume's near
+//                   plane of 150 mm), a table below
 //
 // The rotations are applied in the hand frame, before the motion's: R = R_motion Rx(tip) Ry(turn),
 // where Ry(turn) turns about the hand's own finger axis (y_h) and Rx(tip) about its x_h axis (at
@@ -39,5 +40,11 @@ std::string_view view_description(View view);  // one line for --list-views
 // The motion's pose seen in `view`: turned about the palm centre and, where the arrangement fixes
 // it, moved to its distance from the camera. kPalm returns `pose` unchanged.
 HandPose view_pose(View view, const HandPose& pose, const HandShape& shape);
+
+// `shape` with its forearm as `view` holds it. The desk views keep HandShape's forearm, rigid in
+// the hand frame. The head-mounted view brings it up from below the camera, whatever the motion
+// does with the hand (the wrist bends): rigid in the hand frame it would point at the lens
+// whenever a motion rolls or tips the hand toward it, and cover the hand or the whole image.
+HandShape view_shape(View view, HandShape shape);
 
 }  // namespace handtrack::synth
