@@ -65,6 +65,7 @@ void HandsTracker::reset() {
     s.current = TrackerOutput{};
     s.id = 0;
     s.hidden_frames = 0;
+    s.side_told = false;
   }
   rejected_count_ = 0;
 }
@@ -115,8 +116,22 @@ void HandsTracker::face_other_hands() {
     // Two hands in one frame are usually a left and a right one: the slot expects to be the hand
     // the other is not (it decides choices between left and right that its fits leave open, and,
     // where the other hand's side is the clearer of the two, those they do not make clear).
+    //
+    // Until either hand's side has been told (both still in their first trial: flat hands side-on
+    // to the camera, clapping), following the other is following a coin flip: whichever hand's
+    // evidence first strays from the tie takes a side, the other the opposite, and in two_clap both
+    // were wrong in up to 45 % of the frames. Then the hand further left in the image is expected
+    // to be the right hand, as a camera facing the user sees them (the assumption of the lone
+    // hand's palm-toward rule, Tracker::weigh), for every choice its evidence does not make clear
+    // (docs/TRACKER.md, "Two hands": "A pair not yet told apart").
     const bool other_left = other->last.handedness == Handedness::kLeft;
-    slot.tracker.expect(other_left ? Handedness::kRight : Handedness::kLeft, other->last.handedness_confidence);
+    if (slot.id != 0 && !slot.side_told && !other->side_told) {
+      const auto image_x = [](const TrackerOutput& o) { return o.palm_centre.x() / o.palm_centre.z(); };
+      const bool image_left = image_x(slot.last) < image_x(other->last);
+      slot.tracker.expect(image_left ? Handedness::kRight : Handedness::kLeft, config_.handedness_margin);
+    } else {
+      slot.tracker.expect(other_left ? Handedness::kRight : Handedness::kLeft, other->last.handedness_confidence);
+    }
     if ((fitting_ & (1U << static_cast<unsigned>(s))) == 0) continue;
     // The other hand's last params are the right-hand model's, in the mirrored image for a left
     // hand: posed as they are, its Gaussians are in the camera frame after mirroring x exactly when
@@ -168,6 +183,7 @@ HandsOutput HandsTracker::finish() {
       }
       slot.id = 0;
       slot.hidden_frames = 0;
+      slot.side_told = false;
       slot.tracker.reset();
       slot.last = TrackerOutput{};
       continue;
@@ -175,6 +191,7 @@ HandsOutput HandsTracker::finish() {
     slot.hidden_frames = 0;
     if (slot.id == 0) slot.id = ++last_id_;
     slot.current.hand_id = slot.id;
+    slot.side_told = slot.side_told || slot.current.handedness_confidence >= config_.handedness_margin;
     slot.last = slot.current;
     out.hands[static_cast<size_t>(out.count)] = slot.current;
     out.optimize_ms[static_cast<size_t>(out.count)] = slot.optimize_ms;

@@ -142,6 +142,9 @@ class HandsTracker {
     double optimize_ms = 0.0;
     uint32_t id = 0;         // handtrack's hand id, 0 while free
     int hidden_frames = 0;   // frames in a row without a fit while holding an id
+    // Its side has been clear (handedness_confidence >= TrackerConfig::handedness_margin) in some
+    // frame since it appeared: its first handedness trial has ended.
+    bool side_told = false;
     std::optional<Eigen::Vector3d> trying;  // a free slot's new surface this frame
     // The other hand's last pose, as this slot's right-hand tracker sees it and as its left-hand
     // tracker does (begin()).

@@ -378,7 +378,8 @@ class Tracker {
     right_.set_other_hand(as_right);
     left_.set_other_hand(as_left);
   }
-  // Which hand this one probably is (HandsTracker: not the other hand in view), for choices within
+  // Which hand this one probably is (HandsTracker: not the other hand in view, or, while neither
+  // hand's side has been told, the one its place in the image says), for choices within
   // handedness_tie, and for choices short of handedness_margin while the other hand's side is the
   // clearer choice (`other_clarity`: its handedness_confidence); nullopt: no expectation.
   void expect(std::optional<Handedness> hand, double other_clarity = 0.0) {
