@@ -88,6 +88,17 @@ SceneRun track_scene(const std::string& motion, int frames, int hidden_from = -1
   return run;
 }
 
+// Each hand of `run` posed in at least `min_posed` frames, on its own side in at least `min_pct` %
+// of them, and never given the other hand's id.
+void expect_sides_held(const SceneRun& run, int min_posed, int min_pct) {
+  for (int k = 0; k < 2; ++k) {
+    const eval::SequenceScore& h = run.hand(k);
+    EXPECT_GE(h.posed_frames, min_posed) << "hand " << k;
+    EXPECT_GE(h.hand_correct, h.posed_frames * min_pct / 100) << "hand " << k << ": fitted as the other side too often";
+    EXPECT_EQ(h.identity_swaps, 0) << "hand " << k;
+  }
+}
+
 TEST(TwoHands, BothHandsTrackedApartEachWithItsSide) {
   const SceneRun run = track_scene("two_apart", 120);
   for (int k = 0; k < 2; ++k) {
@@ -114,13 +125,7 @@ TEST(TwoHands, AHandKeepsItsSideWhereTheOtherHandsSideIsTheClearerChoice) {
   // right hand's own evidence stays short of the margin while the left hand's is clearer. When
   // its evidence merely left the tie it took the left hand's side, in 23 of 300 frames (92.3 %
   // right); now the clearer hand decides the pair (Tracker::weigh): 100 %.
-  const SceneRun run = track_scene("two_cross", 300, -1, -1, 6);
-  for (int k = 0; k < 2; ++k) {
-    const eval::SequenceScore& h = run.hand(k);
-    EXPECT_GE(h.posed_frames, 290);
-    EXPECT_GE(h.hand_correct, h.posed_frames * 97 / 100) << "hand " << k << ": fitted as the other side too often";
-    EXPECT_EQ(h.identity_swaps, 0);
-  }
+  expect_sides_held(track_scene("two_cross", 300, -1, -1, 6), 290, 97);
 }
 
 TEST(TwoHands, ClappingHandsNotYetToldApartTakeTheSidesTheirPlacesSay) {
@@ -129,13 +134,7 @@ TEST(TwoHands, ClappingHandsNotYetToldApartTakeTheSidesTheirPlacesSay) {
   // went to the side whichever strayed first: both wrong in 32 % of the frames. Now, until either
   // side has been told, the hand on the image's left is expected to be the right hand
   // (HandsTracker::face_other_hands).
-  const SceneRun run = track_scene("two_clap", 300, -1, -1, 4);
-  for (int k = 0; k < 2; ++k) {
-    const eval::SequenceScore& h = run.hand(k);
-    EXPECT_GE(h.posed_frames, 290);
-    EXPECT_GE(h.hand_correct, h.posed_frames * 98 / 100) << "hand " << k << ": fitted as the other side";
-    EXPECT_EQ(h.identity_swaps, 0);
-  }
+  expect_sides_held(track_scene("two_clap", 300, -1, -1, 4), 290, 98);
 }
 
 TEST(TwoHands, AHandThatLeavesComesBackWithAFreshId) {
