@@ -175,6 +175,58 @@ void expect_error(const std::vector<uint8_t>& bytes, const std::string& what) {
   EXPECT_EQ(e.find('\n'), std::string::npos) << "one line: " << e;
 }
 
+// A forest's nodes are laid out in blocks for the descent (part_forest.cpp, lay_out_in_blocks):
+// the same tree, node for node, whatever order it came in. A complete tree of depth 7, written
+// depth first as the trainer writes it, against its laid-out copy walked in step; the three levels
+// below the root come first; and a forest laid out is laid out again unchanged.
+TEST(PartForestLayout, TheSameTreeInBlocksBreadthFirst) {
+  PartForestTree depth_first;
+  constexpr int kDepth = 7;
+  // Node `i` of depth `d`: its children are the next pair; the left subtree follows them.
+  const auto grow = [&](auto& self, uint32_t i, int d) -> void {
+    PartForestNode& n = depth_first.nodes[i];
+    n.u = {static_cast<int16_t>(i), static_cast<int16_t>(d)};
+    n.threshold = static_cast<float>(i);
+    if (d == kDepth) {
+      n.child = PartForestNode::kLeafBit | static_cast<uint32_t>(depth_first.leaves.size());
+      depth_first.leaves.push_back(one_hot(1 + static_cast<int>(i % 3)));
+      return;
+    }
+    const auto c = static_cast<uint32_t>(depth_first.nodes.size());
+    depth_first.nodes[i].child = c;
+    depth_first.nodes.resize(depth_first.nodes.size() + 2);
+    self(self, c, d + 1);
+    self(self, c + 1, d + 1);
+  };
+  depth_first.nodes.resize(1);
+  grow(grow, 0, 0);
+  ASSERT_EQ(depth_first.nodes.size(), (1U << (kDepth + 1)) - 1);
+  PartForestInfo info;
+  const PartForest forest({depth_first}, info);
+  const PartForestTree& laid_out = forest.trees()[0];
+  ASSERT_EQ(laid_out.nodes.size(), depth_first.nodes.size());
+  int compared = 0;
+  const auto walk = [&](auto& self, uint32_t a, uint32_t b) -> void {
+    const PartForestNode& x = depth_first.nodes[a];
+    const PartForestNode& y = laid_out.nodes[b];
+    ++compared;
+    ASSERT_EQ(x.u, y.u);
+    ASSERT_EQ(x.threshold, y.threshold);
+    ASSERT_EQ(x.is_leaf(), y.is_leaf());
+    if (x.is_leaf()) {
+      ASSERT_EQ(depth_first.leaves[x.leaf_index()], laid_out.leaves[y.leaf_index()]);
+      return;
+    }
+    self(self, x.child, y.child);
+    self(self, x.child + 1, y.child + 1);
+  };
+  walk(walk, 0, 0);
+  EXPECT_EQ(compared, static_cast<int>(depth_first.nodes.size()));
+  // Nodes 1..14: the root's children, grandchildren and great-grandchildren (u.y is the depth).
+  for (int k = 1; k <= 14; ++k) EXPECT_LE(laid_out.nodes[static_cast<size_t>(k)].u[1], 3) << "node " << k;
+  EXPECT_EQ(PartForest({laid_out}, info).to_bytes(), forest.to_bytes());
+}
+
 TEST(PartForestFile, RoundTripKeepsEveryByteAndEveryLabel) {
   const PartForest& m = small_model();
   const fs::path file = fs::path(HANDTRACK_BINARY_DIR) / "test_part_forest_roundtrip.htf";
