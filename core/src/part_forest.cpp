@@ -153,6 +153,9 @@ std::string validate(const std::vector<PartForestTree>& trees, const PartForestI
     if (nodes.empty()) return where() + ": no nodes";
     if (nodes.size() > PartForest::kMaxNodesPerTree) return where() + ": too many nodes";
     if (leaves.size() > nodes.size()) return where() + ": more leaves than nodes";
+    // A tree: every node but the root is the child of exactly one node (two parents would make
+    // the paths, which lay_out_in_blocks() follows, grow exponentially with the depth).
+    std::vector<uint8_t> parents(nodes.size(), 0);
     for (size_t i = 0; i < nodes.size(); ++i) {
       const PartForestNode& n = nodes[i];
       if (n.is_leaf()) {
@@ -168,6 +171,12 @@ std::string validate(const std::vector<PartForestTree>& trees, const PartForestI
                std::to_string(nodes.size()) + " nodes)";
       }
       if (!std::isfinite(n.threshold)) return node(i) + ": threshold is not finite";
+      for (const uint32_t c : {n.child, n.child + 1}) {
+        if (++parents[c] > 1) return node(c) + ": a second parent (node " + std::to_string(i) + "): not a tree";
+      }
+    }
+    for (size_t i = 1; i < nodes.size(); ++i) {
+      if (parents[i] == 0) return node(i) + ": no parent: not part of the tree";
     }
     for (size_t l = 0; l < leaves.size(); ++l) {
       uint32_t sum = 0;

@@ -281,8 +281,22 @@ TEST(PartForestFile, CorruptFilesGiveOneLineNamingTheProblem) {
   std::memcpy(bytes.data() + nodes_at + 12, &self, 4);
   fix_checksum(bytes);
   expect_error(bytes, "out of range");
-  bytes = good;
   const auto& t0 = small_model().trees()[0];
+  // A node given another node's children: two parents, no longer a tree (its paths could grow
+  // exponentially with the depth).
+  bool shared = false;
+  for (size_t i = 0; i < t0.nodes.size() && !shared; ++i) {
+    for (size_t j = i + 1; j < t0.nodes.size() && !shared; ++j) {
+      if (t0.nodes[i].is_leaf() || t0.nodes[j].is_leaf() || t0.nodes[i].child <= j) continue;
+      bytes = good;
+      std::memcpy(bytes.data() + nodes_at + 16 * j + 12, &t0.nodes[i].child, 4);
+      fix_checksum(bytes);
+      expect_error(bytes, "not a tree");
+      shared = true;
+    }
+  }
+  EXPECT_TRUE(shared) << "the small model has two internal nodes to join";
+  bytes = good;
   const size_t leaves_at = nodes_at + 16 * t0.nodes.size();
   std::memset(bytes.data() + leaves_at, 0, 2 * kPartForestClasses);
   fix_checksum(bytes);
