@@ -177,8 +177,9 @@ void expect_error(const std::vector<uint8_t>& bytes, const std::string& what) {
 
 // A forest's nodes are laid out in blocks for the descent (part_forest.cpp, lay_out_in_blocks):
 // the same tree, node for node, whatever order it came in. A complete tree of depth 7, written
-// depth first as the trainer writes it, against its laid-out copy walked in step; the three levels
-// below the root come first; and a forest laid out is laid out again unchanged.
+// depth first (the trainer numbers nodes breadth first; a file may hold any order whose children
+// follow their parent), against its laid-out copy walked in step; the three levels below the root
+// come first; and a forest laid out is laid out again unchanged.
 TEST(PartForestLayout, TheSameTreeInBlocksBreadthFirst) {
   PartForestTree depth_first;
   constexpr int kDepth = 7;
