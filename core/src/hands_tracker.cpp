@@ -122,13 +122,15 @@ void HandsTracker::face_other_hands() {
     // evidence first strays from the tie takes a side, the other the opposite, and in two_clap both
     // were wrong in up to 45 % of the frames. Then the hand further left in the image is expected
     // to be the right hand, as a camera facing the user sees them (the assumption of the lone
-    // hand's palm-toward rule, Tracker::weigh), for every choice its evidence does not make clear
+    // hand's palm-toward rule, Tracker::weigh), and the hand further right for a head-mounted
+    // camera (TrackerConfig::arrangement), for every choice its evidence does not make clear
     // (docs/TRACKER.md, "Two hands": "A pair not yet told apart").
     const bool other_left = other->last.handedness == Handedness::kLeft;
     if (slot.id != 0 && !slot.side_told && !other->side_told) {
       const auto image_x = [](const TrackerOutput& o) { return o.palm_centre.x() / o.palm_centre.z(); };
       const bool image_left = image_x(slot.last) < image_x(other->last);
-      slot.tracker.expect(image_left ? Handedness::kRight : Handedness::kLeft, config_.handedness_margin);
+      const bool right = image_left == (config_.arrangement == CameraArrangement::kFacing);
+      slot.tracker.expect(right ? Handedness::kRight : Handedness::kLeft, config_.handedness_margin);
     } else {
       slot.tracker.expect(other_left ? Handedness::kRight : Handedness::kLeft, other->last.handedness_confidence);
     }

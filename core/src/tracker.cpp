@@ -151,6 +151,15 @@ std::optional<Handedness> palm_toward_camera(const TrackerOutput& as_right, cons
   return right_palm ? Handedness::kRight : Handedness::kLeft;
 }
 
+// The hand of the two fits that shows the camera the side its arrangement expects (the palm, or
+// for a head-mounted camera the back), where exactly one fit's palm faces the camera.
+std::optional<Handedness> expected_side_toward_camera(const TrackerOutput& as_right, const TrackerOutput& as_left,
+                                                      CameraArrangement arrangement) {
+  const std::optional<Handedness> palm = palm_toward_camera(as_right, as_left);
+  if (!palm || arrangement == CameraArrangement::kFacing) return palm;
+  return opposite(*palm);
+}
+
 // A fit's palm faces the camera squarely (either side of it): its normal within 45 deg of the
 // viewing axis.
 bool squarely_facing(const TrackerOutput& fit) { return std::abs(fit.palm_normal.z()) > std::numbers::sqrt2 / 2.0; }
@@ -207,7 +216,8 @@ void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left)
   // evidence near the tie, and one of them turned to the other's side on evidence of 0.05, the
   // other following it within its tie, both wrong (docs/TRACKER.md, "Two hands"). Else, on
   // the trial's first frame, to the palm toward the camera, the common view of a desk camera facing
-  // the user; later, the hand reported so far is kept until the evidence leaves the tie (the palm
+  // the user (the back, for a head-mounted camera: TrackerConfig::arrangement); later, the hand
+  // reported so far is kept until the evidence leaves the tie (the palm
   // rule on every frame of a tie, replayed over the benchmark's logs: handedness 92.6 -> 92.0 %,
   // wrong for every hand seen from the back).
   //
@@ -231,7 +241,8 @@ void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left)
   } else if (expected_) {
     current_ = *expected_;
   } else if (trial_frames_ == 0) {
-    current_ = palm_toward_camera(as_right, as_left).value_or(evidence_ > 0.0 ? Handedness::kLeft : Handedness::kRight);
+    current_ = expected_side_toward_camera(as_right, as_left, config().arrangement)
+                   .value_or(evidence_ > 0.0 ? Handedness::kLeft : Handedness::kRight);
   }
   ++trial_frames_;
   trial_pending_ = false;

@@ -54,4 +54,12 @@ bool parse_handedness_mode(const std::string& text, HandednessMode* mode) {
   return parse_name(text, {HandednessMode::kAuto, HandednessMode::kLeft, HandednessMode::kRight}, mode);
 }
 
+const char* to_string(CameraArrangement arrangement) {
+  return arrangement == CameraArrangement::kHeadMounted ? "head-mounted" : "facing";
+}
+
+bool parse_camera_arrangement(const std::string& text, CameraArrangement* arrangement) {
+  return parse_name(text, {CameraArrangement::kFacing, CameraArrangement::kHeadMounted}, arrangement);
+}
+
 }  // namespace handtrack

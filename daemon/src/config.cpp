@@ -126,6 +126,15 @@ const std::vector<Field>& fields() {
                "auto, left, right"},
      0, 0, "auto | left | right: which hand the tracker fits (auto: both from every (re)start, until several frames tell)",
      true},
+    {"tracker.arrangement",
+     ChoiceRef{[](DaemonConfig& c) { return to_string(c.tracker.arrangement); },
+               [](DaemonConfig& c, const std::string& v) { return parse_camera_arrangement(v, &c.tracker.arrangement); },
+               "facing, head-mounted"},
+     0, 0,
+     "facing | head-mounted: where the camera looks from (a camera facing the user, or one at the user's eyes); "
+     "auto handedness expects the palm or the back toward it, and the right hand on the image's left or right, "
+     "where the depth leaves it open",
+     true},
     {"tracker.handedness_recheck_frames",
      IntRef{[](DaemonConfig& c) -> int& { return c.tracker.handedness_recheck_frames; }}, 0, 100000,
      "auto: a hand whose fit stays below recheck_below_confidence is tried as the other hand again every this many "

@@ -18,11 +18,12 @@ using Eigen::Matrix3d;
 using Eigen::Vector3d;
 using HandAngles = std::array<FingerAngles, kNumFingers>;
 
-enum Scene { kApart, kClap, kCross, kPinch };  // kTwoHandMotionNames order
+enum Scene { kApart, kClap, kCross, kPinch, kReach };  // kTwoHandMotionNames order
 
 struct SceneRecipe {
   std::string_view description;
   std::array<std::string_view, kTwoHands> finger_motions;  // motions.hpp names; "" = flat hands
+  View view = View::kPalm;                                 // the camera arrangement
 };
 
 // clang-format off
@@ -33,6 +34,8 @@ constexpr std::array<SceneRecipe, kTwoHandMotionNames.size()> kRecipes = {{
     {"the right hand passes in front of the left: they cross in the image and swap sides (a 4 s cycle)",
      {"adbadd", "fingerwave"}},
     {"both hands pinch, the left 0.8 s behind, palms turned 20 deg toward each other", {"pinch", "pinch"}},
+    {"a head-mounted camera over both hands reaching forward: backs toward it, the right hand on the right",
+     {"pinch", "fingerwave"}, View::kHeadMounted},
 }};
 // clang-format on
 
@@ -44,6 +47,10 @@ constexpr double kPinchTurnRad = -20.0 * std::numbers::pi / 180.0;  // about y: 
 constexpr double kPinchLagSeconds = 0.8;                             // a third of pinch's 2.4 s cycle
 constexpr double kHeldHeightMm = 15.0;                               // palm centre y (down)
 constexpr double kHeldDepthMm = 420.0;
+// two_reach: the palm centres 200 mm apart at the head-mounted arrangement's 330 mm (views.cpp),
+// where the design pose is placed along its ray; the right hand on the image's right (x > 0).
+constexpr double kReachHalfSeparationMm = 100.0;
+constexpr double kReachDepthMm = 330.0;
 
 // two_cross: x = -kCrossHalfWidthMm cos(2 pi tau / kCrossCycleSeconds) for both design poses (so
 // the right hand goes from the left of the image to the right and back, the left hand the other
@@ -151,6 +158,13 @@ std::string_view two_hand_motion_description(std::string_view name) {
   return {};
 }
 
+View two_hand_view(std::string_view name) {
+  for (size_t i = 0; i < kTwoHandMotionNames.size(); ++i) {
+    if (kTwoHandMotionNames[i] == name) return kRecipes[i].view;
+  }
+  return View::kPalm;
+}
+
 TwoHandMotion::TwoHandMotion(std::string_view name, int frames, double fps,
                              const std::array<HandShape, kTwoHands>& shapes)
     : frames_(frames), fps_(fps), shapes_(shapes) {
@@ -193,6 +207,13 @@ TwoHandPoses TwoHandMotion::pose(int frame) const {
       case kPinch:
         place_palm(pose, shapes_[k], d.turn * AngleAxisd(kPinchTurnRad, Vector3d::UnitY()).toRotationMatrix(),
                    Vector3d(-kPinchHalfSeparationMm, kHeldHeightMm, kHeldDepthMm) + d.offset_mm);
+        break;
+      case kReach:
+        // Held as in front of a desk camera, then turned and placed as the head-mounted arrangement
+        // holds one hand (views.hpp): about its own palm centre, along the ray to 330 mm.
+        place_palm(pose, shapes_[k], d.turn,
+                   Vector3d(kReachHalfSeparationMm, kHeldHeightMm, kReachDepthMm) + d.offset_mm);
+        pose = view_pose(View::kHeadMounted, pose, shapes_[k]);
         break;
       default: {  // kCross: a third of the drift's offset, so the two depths stay apart
         const double x = -kCrossHalfWidthMm * std::cos(kTwoPi * tau / kCrossCycleSeconds);

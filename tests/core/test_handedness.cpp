@@ -293,6 +293,35 @@ TEST(HandednessRetrial, AHandChosenWrongOnAFistIsTriedAgain) {
                                    "the trials again";
 }
 
+// A flat hand seen from the back (adbadd in the back view, subject 3, as in scripts/eval-synthetic):
+// its right-hand fit and the left hand's mirror image with the palm toward the camera explain the
+// depth alike, and its first trial's evidence is a tie. What the depth leaves open, the camera's
+// arrangement decides (TrackerConfig::arrangement, Tracker::weigh): a camera facing the user
+// expects the palm, and reports this hand as a left hand throughout; a head-mounted camera expects
+// the back, and reports the right hand.
+TEST(HandednessTie, AFlatHandShowsTheSideItsCamerasArrangementExpects) {
+  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  synth::SynthOptions options;
+  options.motion = "adbadd";
+  options.view = synth::View::kBack;
+  options.hand = synth::Handedness::kRight;
+  options.frames = 300;
+  options.seed = 3;
+  const auto share_right = [&](CameraArrangement arrangement) {
+    TrackerConfig config;
+    config.mode = EnergyMode::kLateFusion;
+    config.arrangement = arrangement;
+    const testing::OneHandRun run = testing::track_one_hand(options, config, &forest);
+    std::printf("%s: %d of %d frames reported as the right hand, %.1f mm\n", to_string(arrangement),
+                run.reported_as_shown, run.posed, run.mean_error_mm());
+    EXPECT_LE(run.mean_error_mm(), 12.0) << to_string(arrangement) << ": either hand fits this flat hand";
+    return run.posed > 0 ? static_cast<double>(run.reported_as_shown) / run.posed : 0.0;
+  };
+  EXPECT_GE(share_right(CameraArrangement::kHeadMounted), 0.95);
+  EXPECT_LE(share_right(CameraArrangement::kFacing), 0.05)
+      << "the depth now tells this hand's side: this scene no longer tests the arrangement";
+}
+
 // A trial fits both hands, and a hand lost in it (its start found nothing) is not started again
 // while checks are off the frame (spread, or in the background: handtrackd's default); its input
 // is not built either (Tracker::request). In handtrack-bench's scene (random, seed 7) the left

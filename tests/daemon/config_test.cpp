@@ -51,12 +51,13 @@ TEST(DaemonConfig, ShippedFileEqualsTheDefaults) {
 TEST(DaemonConfig, ValuesOverrideDefaults) {
   const auto c = parse_config(
       "[daemon]\nsource = \"synthetic:pinch\"\nlog_level = \"debug\"\n"
-      "[tracker]\nparticles = 1\n[tracker.energy]\nw_s = 2.5\nw_c_tracking = 0.75\n[tracker.optimizer]\niterations = 20\n"
+      "[tracker]\nparticles = 1\narrangement = \"head-mounted\"\n[tracker.energy]\nw_s = 2.5\nw_c_tracking = 0.75\n[tracker.optimizer]\niterations = 20\n"
       "[tracker.input]\nfar_mm = 700\n[pipeline]\ncpu_optimize = 1\n",
       "x.toml");
   EXPECT_EQ(c.source, "synthetic:pinch");
   EXPECT_EQ(c.log_level, LogLevel::kDebug);
   EXPECT_EQ(c.tracker.particles, 1);
+  EXPECT_EQ(c.tracker.arrangement, CameraArrangement::kHeadMounted);
   EXPECT_DOUBLE_EQ(c.tracker.weights.smoothness, 2.5);
   EXPECT_DOUBLE_EQ(c.tracker.weights.tracking_collision, 0.75);
   EXPECT_EQ(c.tracker.optimizer.iterations, 20);
@@ -73,6 +74,7 @@ TEST(DaemonConfig, BadValuesNameFileFieldAndRange) {
   EXPECT_EQ(error_of("[tracker]\nparticles = 1.5\n"),
             "test.toml: tracker.particles must be an integer (allowed range 1..64)");
   EXPECT_EQ(error_of("[daemon]\nfast = 1\n"), "test.toml: daemon.fast must be true or false");
+  EXPECT_EQ(error_of("[tracker]\narrangement = \"desk\"\n").find("test.toml: tracker.arrangement"), 0U);
   EXPECT_EQ(error_of("[daemon]\nsource = \"\"\n"),
             "test.toml: daemon.source = '': allowed: a string of 1 to 4096 characters");
   EXPECT_NE(error_of("[nope]\nx = 1\n").find("unknown field 'nope.x'"), std::string::npos);

@@ -97,7 +97,7 @@ TEST_F(SynthCli, HelpAndListMotions) {
   const RunResult list = run("--list-motions");
   EXPECT_EQ(list.exit_code, 0);
   for (const char* m : {"adbadd", "fingercount", "fingerwave", "flexex1", "pinch", "random", "tigergrasp", "two_apart",
-                        "two_clap", "two_cross", "two_pinch"}) {
+                        "two_clap", "two_cross", "two_pinch", "two_reach"}) {
     EXPECT_NE(list.out.find(m), std::string::npos) << m;
   }
 }

@@ -202,6 +202,12 @@ int main(int argc, char** argv) {
                  "coordinates (mm; empty where not annotated); what scripts/filter-table smooths");
   app.add_option("--hand", hand, "auto (default: both hands, the better fit chosen at every (re)start), right or left")
       ->check(CLI::IsMember({"right", "left", "auto"}));
+  std::string arrangement = "facing";
+  app.add_option("--arrangement", arrangement,
+                 "facing (default: a camera facing the user) or head-mounted (at the user's eyes): which side of a "
+                 "hand, and which hand on which side of the image, auto handedness expects where the depth leaves "
+                 "it open (handtrackd's tracker.arrangement)")
+      ->check(CLI::IsMember({"facing", "head-mounted"}));
   app.add_option("--energy", energy, "late-fusion (default, with the shipped forest) or depth-only")
       ->check(CLI::IsMember({"depth-only", "late-fusion"}));
   std::string forest_file;
@@ -275,6 +281,7 @@ int main(int argc, char** argv) {
   }
   if (energy == "late-fusion") config.mode = EnergyMode::kLateFusion;
   parse_handedness_mode(hand, &config.handedness);  // one of the names CLI11 checked
+  parse_camera_arrangement(arrangement, &config.arrangement);
   if (sim_only) {
     config.weights.collision = config.weights.tracking_collision = 0.0;
     config.weights.limits = config.weights.smoothness = 0.0;

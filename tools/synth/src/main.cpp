@@ -99,6 +99,7 @@ void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticC
     j["pose_parameters"] = j["pose_parameters"].get<std::string>() +
                            "; hand 1's columns prefixed h1_, its pose the right-hand model's whose mirror image "
                            "(x -> -x) it is";
+    j["view"] = std::string(handtrack::synth::view_name(handtrack::synth::two_hand_view(o.motion)));
     j["hands"] = nlohmann::json::array();
     for (int k = 0; k < cam.hand_count(); ++k) {
       j["hands"].push_back({{"hand", k == 0 ? "right" : "left"},
@@ -199,7 +200,7 @@ int main(int argc, char** argv) {
                                              "from the seed within +-10%)");
   app.add_flag("--noise,!--no-noise", options.noise, "Sensor noise model on (default) or off");
   app.add_option("--background", background,
-                 "Background: body (default; head-mounted view: table), table, desk (the hand rests on it), "
+                 "Background: body (default; head-mounted view and two_reach: table), table, desk (the hand rests on it), "
                  "near-body (a user close to the camera: torso and head inside the working volume) or none");
   double ball_radius_mm = 0.0;
   app.add_option("--ball", ball_radius_mm, "Radius (mm) of a ball held against the palm (default 0: none)")
@@ -247,7 +248,9 @@ int main(int argc, char** argv) {
   }
   const auto arrangement = handtrack::synth::parse_view(view);
   if (!arrangement) return fail("unknown view '" + view + "' (see --list-views)");
-  if (background.empty()) background = *arrangement == handtrack::synth::View::kHeadMounted ? "table" : "body";
+  // A head-mounted camera looks down at a table (a two-hand scene: its own arrangement).
+  const auto seen_in = handtrack::synth::is_two_hand_motion(motion) ? handtrack::synth::two_hand_view(motion) : *arrangement;
+  if (background.empty()) background = seen_in == handtrack::synth::View::kHeadMounted ? "table" : "body";
   const auto bg = handtrack::synth::parse_background(background);
   if (!bg) return fail("--background must be body, table, desk, near-body or none, got '" + background + "'");
   const auto handedness = handtrack::synth::parse_handedness(hand);

@@ -54,6 +54,7 @@ struct Args {
   bool crop = false;
   int panel_height = 0;
   std::string energy = "late-fusion";
+  std::string arrangement = "facing";
   std::string forest;
 };
 
@@ -67,6 +68,7 @@ handtrack::TrackerConfig tracker_config(const Args& a) {
   if (a.far_mm) config.input.far_mm = *a.far_mm;
   if (config.input.far_mm <= config.input.near_mm) throw UsageError("--far-mm must be greater than --near-mm");
   if (a.energy == "late-fusion") config.mode = handtrack::EnergyMode::kLateFusion;
+  handtrack::parse_camera_arrangement(a.arrangement, &config.arrangement);  // one of the names CLI11 checked
   return config;
 }
 
@@ -269,6 +271,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 10000.0));
   app.add_option("--energy", a.energy, "late-fusion (default, with the shipped forest) or depth-only")
       ->check(CLI::IsMember({"late-fusion", "depth-only"}));
+  app.add_option("--arrangement", a.arrangement,
+                 "facing (default: a camera facing the user) or head-mounted (at the user's eyes), as handtrackd's "
+                 "tracker.arrangement")
+      ->check(CLI::IsMember({"facing", "head-mounted"}));
   app.add_option("--forest", a.forest,
                  "part-classification forest for late fusion (default: the shipped one, $HANDTRACK_FOREST, data/ or "
                  "/usr/share/handtrack)")

@@ -35,6 +35,17 @@ const char* to_string(Handedness hand);  // "right", "left"
 enum class HandednessMode : uint8_t { kRight, kLeft, kAuto };
 const char* to_string(HandednessMode mode);  // "right", "left", "auto"
 bool parse_handedness_mode(const std::string& text, HandednessMode* mode);
+// Where the camera looks at the user's hands from (ours): what the depth cannot tell. A right
+// hand's palm and a left hand's back are mirror images through the hand's plane, one surface to
+// the camera where the hand is flat, so where a hand's evidence leaves its side open the tracker
+// goes by the arrangement (Tracker::weigh, HandsTracker):
+//   kFacing       a camera facing the user (on a desk or a screen): a hand shows its palm, and
+//                 of two hands the right one is on the image's left;
+//   kHeadMounted  a camera at the user's eyes (a headset) looking where the hands reach: a hand
+//                 shows its back, and the right hand is on the image's right.
+enum class CameraArrangement : uint8_t { kFacing, kHeadMounted };
+const char* to_string(CameraArrangement arrangement);  // "facing", "head-mounted"
+bool parse_camera_arrangement(const std::string& text, CameraArrangement* arrangement);
 
 // Which energies the particles optimise (Sec. 5).
 enum class EnergyMode {
@@ -58,6 +69,7 @@ struct TrackerConfig {
   // handtrack-eval default to late fusion with the shipped forest.
   EnergyMode mode = EnergyMode::kDepthOnly;
   HandednessMode handedness = HandednessMode::kAuto;  // Tracker only (a PoseTracker is one hand)
+  CameraArrangement arrangement = CameraArrangement::kFacing;  // auto handedness's open choices
   DepthInputConfig input;
   EnergyWeights weights;
   OptimizerConfig optimizer;

@@ -13,15 +13,21 @@
 //              and fingerwave (left)
 //   two_pinch  both hands pinch (each pinch solved for its subject), the left 0.8 s behind, the
 //              palms turned 20 deg toward each other, ~210 mm apart
+//   two_reach  a head-mounted camera over both hands reaching forward (views.hpp's head-mounted
+//              arrangement for each: the backs toward the camera, the fingers 65 deg away, the
+//              forearms up from below the camera, a table below), the right hand on the image's
+//              right, palm centres ~200 mm apart; the right hand pinches, the left does fingerwave
 //
 // Hand 0 is a right hand, hand 1 a left hand. Both are given as poses of the right-hand model; hand
 // 1 is shown as the mirror image about the camera's x = 0 plane (hand_model.hpp mirror_x), as a
 // one-hand left hand is (synthetic_camera.hpp, Handedness). The scenes are therefore written once,
-// for "design" poses in which each hand is a right hand on the image's left (x < 0, the side a
-// desk camera facing the user sees the right hand on): hand 1's design pose, mirrored, lands on the
-// right. As for one hand, the forearms leave the image (or the working volume) below the hands.
+// for "design" poses in which each hand is a right hand on the side the camera sees the right hand
+// on: the image's left (x < 0) for a desk camera facing the user, the image's right (x > 0) for a
+// head-mounted one; hand 1's design pose, mirrored, lands on the other side. As for one hand, the
+// forearms leave the image (or the working volume) below the hands.
 
 #include "handtrack/synth/motions.hpp"
+#include "handtrack/synth/views.hpp"
 
 #include <array>
 #include <optional>
@@ -29,13 +35,16 @@
 
 namespace handtrack::synth {
 
-inline constexpr std::array<std::string_view, 4> kTwoHandMotionNames = {"two_apart", "two_clap", "two_cross",
-                                                                        "two_pinch"};
+inline constexpr std::array<std::string_view, 5> kTwoHandMotionNames = {"two_apart", "two_clap", "two_cross",
+                                                                        "two_pinch", "two_reach"};
 inline constexpr int kTwoHands = 2;
 
 [[nodiscard]] bool is_two_hand_motion(std::string_view name);
 // One-line description for --list-motions ("" for a name that is not a two-hand motion).
 std::string_view two_hand_motion_description(std::string_view name);
+// The camera arrangement a two-hand scene is seen in (views.hpp): kHeadMounted for two_reach,
+// kPalm (a desk camera facing the user) for the others and for a name that is not a two-hand motion.
+[[nodiscard]] View two_hand_view(std::string_view name);
 
 // The poses of hand 0 (right) and hand 1 (left: shown mirrored) of one frame.
 using TwoHandPoses = std::array<HandPose, kTwoHands>;
