@@ -204,11 +204,30 @@ void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left)
   // hand's plane, the same to the sphere model). As it moves, the fingers flex toward the palm of
   // the true hand only, and the wrong hand's fit explains less of it. So the evidence is the
   // fit-score difference left - right (handedness_difference) averaged over the trial's frames (a
-  // hand that found no fit scores 0), and the hand it favours is reported (docs/TRACKER.md,
+  // hand that lost its fit scores 0), and the hand it favours is reported (docs/TRACKER.md,
   // "Handedness by evidence over frames").
-  const double difference = handedness_difference(as_right, as_left);
-  evidence_ = trial_frames_ == 0 ? difference
-                                 : evidence_ + config().handedness_evidence_rate * (difference - evidence_);
+  //
+  // A hand whose (re)start has found nothing yet in this trial is no evidence either way: its
+  // search missed, which says little about the shape (a fist seen from behind, fingercount
+  // head-mounted s1: the right hand's search found nothing in the trial's first 5 frames, and those
+  // frames, weighed in full, chose the left hand for the whole sequence). The frames count from
+  // the first where both hands have had a fit; a hand that never has one by the trial's end loses
+  // it (`weighed_frames_`).
+  if (trial_frames_ == 0) {
+    trial_fitted_ = {false, false};
+    weighed_frames_ = 0;
+    evidence_ = 0.0;
+  }
+  trial_fitted_[0] = trial_fitted_[0] || as_right.state != TrackingState::kNoHand;
+  trial_fitted_[1] = trial_fitted_[1] || as_left.state != TrackingState::kNoHand;
+  if (trial_fitted_[0] && trial_fitted_[1]) {
+    const double difference = handedness_difference(as_right, as_left);
+    evidence_ = weighed_frames_ == 0 ? difference
+                                     : evidence_ + config().handedness_evidence_rate * (difference - evidence_);
+    ++weighed_frames_;
+  } else if (trial_frames_ + 1 >= config().handedness_trial_frames && trial_fitted_[0] != trial_fitted_[1]) {
+    evidence_ = trial_fitted_[1] ? config().handedness_margin : -config().handedness_margin;
+  }
   // Evidence within handedness_tie is a tie. With another hand in view (HandsTracker) a tie goes to
   // the hand that one is not: two hands in one frame are usually a left and a right one. So does
   // evidence short of handedness_margin where the other hand's is the clearer (expect()): the

@@ -15,6 +15,7 @@
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/core/start_search.hpp"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -440,6 +441,10 @@ class Tracker {
   bool trial_pending_ = true;
   int trial_frames_ = 0;
   double evidence_ = 0.0;
+  // Per hand (right, left): whether it has had a fit in this trial; the frames weighed so far (those
+  // since both have).
+  std::array<bool, 2> trial_fitted_{};
+  int weighed_frames_ = 0;
   // A trial of a hand already chosen (TrackerConfig::handedness_recheck_frames): the chosen hand
   // is reported throughout and kept unless the evidence is clear at the end. Frames since the last
   // trial ended.
