@@ -255,6 +255,34 @@ TEST(RealStillHand, MostStayTheRightHandAsHandtrackdTracksThem) {
                                                << " still frames reported as the right hand";
 }
 
+// A right-hand sequence of scripts/eval-synthetic: `motion` in `view`, subject `seed`, 300 frames,
+// over the background handtrack-synth gives that view.
+synth::SynthOptions benchmark_sequence(const std::string& motion, synth::View view, uint64_t seed) {
+  synth::SynthOptions options;
+  options.motion = motion;
+  options.view = view;
+  options.background = view == synth::View::kHeadMounted ? synth::Background::kTable : synth::Background::kBody;
+  options.hand = synth::Handedness::kRight;
+  options.frames = 300;
+  options.seed = seed;
+  return options;
+}
+
+const PartForest& shipped_forest() {
+  static const PartForest forest = PartForest::load(shipped_forest_path().value());
+  return forest;
+}
+
+// `options` tracked with late fusion as `config` says from frame 0, scored from `from_frame` on.
+testing::OneHandRun track_late_fusion(const synth::SynthOptions& options, TrackerConfig config, int from_frame = 0) {
+  config.mode = EnergyMode::kLateFusion;
+  return testing::track_one_hand(options, config, &shipped_forest(), from_frame);
+}
+
+double share_as_shown(const testing::OneHandRun& run) {
+  return run.posed > 0 ? static_cast<double>(run.reported_as_shown) / run.posed : 0.0;
+}
+
 // A hand whose first trial chose the wrong hand on a fist (fingercount starts as one, which either
 // hand explains) and whose fit stays mediocre is tried as the other hand again
 // (TrackerConfig::handedness_recheck_frames): the shipped configuration reports the hand shown in
@@ -268,24 +296,13 @@ TEST(RealStillHand, MostStayTheRightHandAsHandtrackdTracksThem) {
 // fingercount seen fingers toward, seeds 1-4, seed 1 (both hands) and seed 2's left hand still
 // choose wrong, and the back view's seeds 1-4 none.
 TEST(HandednessRetrial, AHandChosenWrongOnAFistIsTriedAgain) {
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
-  synth::SynthOptions options;
-  options.motion = "fingercount";
-  options.view = synth::View::kFingersToward;
-  options.hand = synth::Handedness::kRight;
-  options.frames = 300;
-  options.seed = 1;
+  const synth::SynthOptions options = benchmark_sequence("fingercount", synth::View::kFingersToward, 1);
   TrackerConfig config;
-  config.mode = EnergyMode::kLateFusion;
   config.weights.smoothness = kPapersSmoothness;
   TrackerConfig without = config;
   without.handedness_recheck_frames = 0;
-  const auto share_as_shown = [&](const TrackerConfig& c) {
-    const testing::OneHandRun run = testing::track_one_hand(options, c, &forest, 150);
-    return run.posed > 0 ? static_cast<double>(run.reported_as_shown) / run.posed : 0.0;
-  };
-  const double with_share = share_as_shown(config);
-  const double without_share = share_as_shown(without);
+  const double with_share = share_as_shown(track_late_fusion(options, config, 150));
+  const double without_share = share_as_shown(track_late_fusion(options, without, 150));
   std::printf("frames 150-299 reported as the right hand: %.2f with trials again, %.2f without\n", with_share,
               without_share);
   EXPECT_GE(with_share, 0.9);
@@ -300,22 +317,15 @@ TEST(HandednessRetrial, AHandChosenWrongOnAFistIsTriedAgain) {
 // expects the palm, and reports this hand as a left hand throughout; a head-mounted camera expects
 // the back, and reports the right hand.
 TEST(HandednessTie, AFlatHandShowsTheSideItsCamerasArrangementExpects) {
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
-  synth::SynthOptions options;
-  options.motion = "adbadd";
-  options.view = synth::View::kBack;
-  options.hand = synth::Handedness::kRight;
-  options.frames = 300;
-  options.seed = 3;
+  const synth::SynthOptions options = benchmark_sequence("adbadd", synth::View::kBack, 3);
   const auto share_right = [&](CameraArrangement arrangement) {
     TrackerConfig config;
-    config.mode = EnergyMode::kLateFusion;
     config.arrangement = arrangement;
-    const testing::OneHandRun run = testing::track_one_hand(options, config, &forest);
+    const testing::OneHandRun run = track_late_fusion(options, config);
     std::printf("%s: %d of %d frames reported as the right hand, %.1f mm\n", to_string(arrangement),
                 run.reported_as_shown, run.posed, run.mean_error_mm());
     EXPECT_LE(run.mean_error_mm(), 12.0) << to_string(arrangement) << ": either hand fits this flat hand";
-    return run.posed > 0 ? static_cast<double>(run.reported_as_shown) / run.posed : 0.0;
+    return share_as_shown(run);
   };
   EXPECT_GE(share_right(CameraArrangement::kHeadMounted), 0.95);
   EXPECT_LE(share_right(CameraArrangement::kFacing), 0.05)
@@ -328,17 +338,8 @@ TEST(HandednessTie, AFlatHandShowsTheSideItsCamerasArrangementExpects) {
 // for 59 % of the sequence. A hand whose search has found nothing yet in a trial is no evidence
 // either way (Tracker::weigh): the right hand in 98 % of the frames.
 TEST(HandednessTrial, AHandWhoseStartFoundNothingYetIsNotOutvotedByIt) {
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
-  synth::SynthOptions options;
-  options.motion = "fingercount";
-  options.view = synth::View::kHeadMounted;
-  options.background = synth::Background::kTable;
-  options.hand = synth::Handedness::kRight;
-  options.frames = 300;
-  options.seed = 8;
-  TrackerConfig config;
-  config.mode = EnergyMode::kLateFusion;
-  const testing::OneHandRun run = testing::track_one_hand(options, config, &forest);
+  const testing::OneHandRun run =
+      track_late_fusion(benchmark_sequence("fingercount", synth::View::kHeadMounted, 8), TrackerConfig{});
   std::printf("%d of %d frames reported as the right hand, %.1f mm\n", run.reported_as_shown, run.posed,
               run.mean_error_mm());
   EXPECT_GE(run.posed, 295);
