@@ -244,6 +244,33 @@ TEST_F(EvalCli, TheWorkingVolumeIsTheUsers) {
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
 }
 
+// The camera's arrangement is the user's to say (handtrackd's tracker.arrangement): a flat right
+// hand seen from the back (adbadd, subject 3), whose two hands' fits tie, is reported as the palm of
+// a left hand by default (a camera facing the user) and as the right hand it is with
+// --arrangement head-mounted. Any other value is one clear line and exit code 1.
+TEST_F(EvalCli, TheCamerasArrangementIsTheUsers) {
+  handtrack::synth::SynthOptions o;
+  o.motion = "adbadd";
+  o.view = handtrack::synth::View::kBack;
+  o.seed = 3;
+  o.frames = 10;
+  const std::string seq = "'" + render("adbadd", o).string() + "'";
+  const auto pct_right = [&](const std::string& args) {
+    std::string err;
+    const fs::path json = dir_ / "eval.json";
+    EXPECT_EQ(eval(&err, seq + args + " --json '" + json.string() + "'"), 0) << err;
+    const auto j = nlohmann::json::parse(std::ifstream(json));
+    return j["sequences"][0]["handedness"]["pct_frames_correct"].get<double>();
+  };
+  std::ofstream(dir_ / "adbadd" / "hand.json") << R"({"hands":["right"],"motion":"adbadd","view":"back"})";
+  EXPECT_EQ(pct_right(""), 0.0);
+  EXPECT_EQ(pct_right(" --arrangement head-mounted"), 100.0);
+  std::string err;
+  EXPECT_EQ(eval(&err, seq + " --arrangement sideways"), 1);
+  EXPECT_NE(err.find("--arrangement"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+}
+
 // A one-hand sequence is tracked as handtrackd tracks it: by a HandsTracker with room for one hand
 // (the frame shared out first), not by a Tracker alone. The scene: a user close to the camera, head
 // and torso in the working volume, where the two differ (a Tracker alone lets the body into the

@@ -286,7 +286,7 @@ TEST_F(ViewCli, FrameOutOfRangeFailsCleanly) {
 
 TEST_F(ViewCli, UsageErrorsAreOneLine) {
   for (const std::string args : {"", "--out x.png", "--seq a --depth b --out x.png", "--frame -3 --out x.png",
-                                 "--bogus"}) {
+                                 "--bogus", "--arrangement sideways --out x.png"}) {
     const ProcessResult r = view(args);
     EXPECT_NE(r.exit_code, 0) << args;
     EXPECT_NE(r.exit_code, 1) << args << ": usage errors are not input errors";
