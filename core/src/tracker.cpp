@@ -211,21 +211,20 @@ void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left)
   // search missed, which says little about the shape (a fist seen from behind, fingercount
   // head-mounted s1: the right hand's search found nothing in the trial's first 5 frames, and those
   // frames, weighed in full, chose the left hand for the whole sequence). The frames count from
-  // the first where both hands have had a fit; a hand that never has one by the trial's end loses
-  // it (`weighed_frames_`).
+  // the first where both hands have had a fit, which starts the average; a hand that never has one
+  // by the trial's end loses it.
+  const int frames = trial_frames_ + 1;
   if (trial_frames_ == 0) {
     trial_fitted_ = {false, false};
-    weighed_frames_ = 0;
     evidence_ = 0.0;
   }
+  const bool weighed_before = trial_fitted_[0] && trial_fitted_[1];
   trial_fitted_[0] = trial_fitted_[0] || as_right.state != TrackingState::kNoHand;
   trial_fitted_[1] = trial_fitted_[1] || as_left.state != TrackingState::kNoHand;
   if (trial_fitted_[0] && trial_fitted_[1]) {
     const double difference = handedness_difference(as_right, as_left);
-    evidence_ = weighed_frames_ == 0 ? difference
-                                     : evidence_ + config().handedness_evidence_rate * (difference - evidence_);
-    ++weighed_frames_;
-  } else if (trial_frames_ + 1 >= config().handedness_trial_frames && trial_fitted_[0] != trial_fitted_[1]) {
+    evidence_ = weighed_before ? evidence_ + config().handedness_evidence_rate * (difference - evidence_) : difference;
+  } else if (frames >= config().handedness_trial_frames && trial_fitted_[0] != trial_fitted_[1]) {
     evidence_ = trial_fitted_[1] ? config().handedness_margin : -config().handedness_margin;
   }
   // Evidence within handedness_tie is a tie. With another hand in view (HandsTracker) a tie goes to
@@ -247,7 +246,6 @@ void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left)
   // evidence already favours the chosen hand by the margin (most find the chosen hand right).
   const bool tie = std::abs(evidence_) < config().handedness_tie;
   const bool clear = std::abs(evidence_) >= config().handedness_margin;
-  const int frames = trial_frames_ + 1;
   const Handedness favoured = evidence_ > 0.0 ? Handedness::kLeft : Handedness::kRight;
   const bool confirmed = retrial_ && clear && favoured == current_ && 3 * frames >= config().handedness_trial_frames;
   const bool done = confirmed || (frames >= config().handedness_trial_frames && (clear || retrial_));

@@ -220,11 +220,9 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
     options.subject = subjects[0];
   }
   // The arrangement holds the forearm (views.hpp view_shape): a two-hand scene's for both hands.
-  const bool two = is_two_hand_motion(options.motion);
-  const View arrangement = two ? two_hand_view(options.motion) : options.view;
+  const View arrangement = seen_in(options.motion, options.view);
   const std::array<HandShape, kTwoHands> shapes{view_shape(arrangement, HandShape::for_subject(subjects[0])),
-                                                 view_shape(two ? arrangement : View::kPalm,
-                                                            HandShape::for_subject(subjects[1]))};
+                                                 view_shape(arrangement, HandShape::for_subject(subjects[1]))};
   state_ = std::make_unique<State>(std::move(options), shapes);
   State& s = *state_;
   std::vector<PlanePatch> planes;

@@ -165,6 +165,8 @@ View two_hand_view(std::string_view name) {
   return View::kPalm;
 }
 
+View seen_in(std::string_view motion, View view) { return is_two_hand_motion(motion) ? two_hand_view(motion) : view; }
+
 TwoHandMotion::TwoHandMotion(std::string_view name, int frames, double fps,
                              const std::array<HandShape, kTwoHands>& shapes)
     : frames_(frames), fps_(fps), shapes_(shapes) {

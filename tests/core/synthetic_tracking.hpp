@@ -16,6 +16,12 @@ namespace handtrack::testing {
 
 inline constexpr int kSequenceFrames = 300;
 
+// The shipped part forest, loaded once per test program.
+inline const PartForest& shipped_forest() {
+  static const PartForest forest = PartForest::load(shipped_forest_path().value());
+  return forest;
+}
+
 inline TrackerConfig paper_config(EnergyMode mode) {
   TrackerConfig config;
   config.mode = mode;

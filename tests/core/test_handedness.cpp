@@ -263,20 +263,15 @@ synth::SynthOptions benchmark_sequence(const std::string& motion, synth::View vi
   options.view = view;
   options.background = view == synth::View::kHeadMounted ? synth::Background::kTable : synth::Background::kBody;
   options.hand = synth::Handedness::kRight;
-  options.frames = 300;
+  options.frames = testing::kSequenceFrames;
   options.seed = seed;
   return options;
-}
-
-const PartForest& shipped_forest() {
-  static const PartForest forest = PartForest::load(shipped_forest_path().value());
-  return forest;
 }
 
 // `options` tracked with late fusion as `config` says from frame 0, scored from `from_frame` on.
 testing::OneHandRun track_late_fusion(const synth::SynthOptions& options, TrackerConfig config, int from_frame = 0) {
   config.mode = EnergyMode::kLateFusion;
-  return testing::track_one_hand(options, config, &shipped_forest(), from_frame);
+  return testing::track_one_hand(options, config, &testing::shipped_forest(), from_frame);
 }
 
 double share_as_shown(const testing::OneHandRun& run) {

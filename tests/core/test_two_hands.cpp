@@ -9,6 +9,7 @@
 #include "handtrack/eval/scoring.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
 #include "handtrack/synth/two_hand_motions.hpp"
+#include "synthetic_tracking.hpp"
 
 #include <gtest/gtest.h>
 
@@ -29,10 +30,7 @@ TrackerConfig shipped_config(int max_hands) {
   return config;
 }
 
-const PartForest& shipped_forest() {
-  static const PartForest forest = PartForest::load(*shipped_forest_path());
-  return forest;
-}
+using testing::shipped_forest;
 
 // A two-hand scene's run, scored as handtrack-eval scores it (per ground-truth hand: matched by
 // position, its error, side and identity swaps; phantom hands), and every hand id seen.

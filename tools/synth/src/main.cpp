@@ -249,8 +249,9 @@ int main(int argc, char** argv) {
   const auto arrangement = handtrack::synth::parse_view(view);
   if (!arrangement) return fail("unknown view '" + view + "' (see --list-views)");
   // A head-mounted camera looks down at a table (a two-hand scene: its own arrangement).
-  const auto seen_in = handtrack::synth::is_two_hand_motion(motion) ? handtrack::synth::two_hand_view(motion) : *arrangement;
-  if (background.empty()) background = seen_in == handtrack::synth::View::kHeadMounted ? "table" : "body";
+  if (background.empty()) {
+    background = handtrack::synth::seen_in(motion, *arrangement) == handtrack::synth::View::kHeadMounted ? "table" : "body";
+  }
   const auto bg = handtrack::synth::parse_background(background);
   if (!bg) return fail("--background must be body, table, desk, near-body or none, got '" + background + "'");
   const auto handedness = handtrack::synth::parse_handedness(hand);

@@ -441,10 +441,9 @@ class Tracker {
   bool trial_pending_ = true;
   int trial_frames_ = 0;
   double evidence_ = 0.0;
-  // Per hand (right, left): whether it has had a fit in this trial; the frames weighed so far (those
-  // since both have).
+  // Per hand (right, left): whether it has had a fit in this trial (its frames are weighed from the
+  // first on which both have).
   std::array<bool, 2> trial_fitted_{};
-  int weighed_frames_ = 0;
   // A trial of a hand already chosen (TrackerConfig::handedness_recheck_frames): the chosen hand
   // is reported throughout and kept unless the evidence is clear at the end. Frames since the last
   // trial ended.

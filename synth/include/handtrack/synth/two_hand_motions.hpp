@@ -45,6 +45,8 @@ std::string_view two_hand_motion_description(std::string_view name);
 // The camera arrangement a two-hand scene is seen in (views.hpp): kHeadMounted for two_reach,
 // kPalm (a desk camera facing the user) for the others and for a name that is not a two-hand motion.
 [[nodiscard]] View two_hand_view(std::string_view name);
+// The arrangement `motion` is rendered in: a two-hand scene's own, else `view` (SynthOptions::view).
+[[nodiscard]] View seen_in(std::string_view motion, View view);
 
 // The poses of hand 0 (right) and hand 1 (left: shown mirrored) of one frame.
 using TwoHandPoses = std::array<HandPose, kTwoHands>;
