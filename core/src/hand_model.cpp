@@ -77,6 +77,21 @@ HandModel HandModel::default_adult(const HandScale& scale) {
       }
     }
   }
+  // Knuckles: the heads of the metacarpals, index to little, kKnuckleDropMm toward the wrist from
+  // each finger's base in the palm's plane. A hand seen from behind, or a fist, shows them most of
+  // all; without them the palm rows end 17 mm short and a fit tips the hand to lay the top row over
+  // them (docs/TRACKER.md, "Knuckles"). They come before the palm rows, so the last Gaussian stays a
+  // row's (palm_half_thickness_mm).
+  constexpr double kKnuckleDropMm = 10.0;
+  for (int f = kIndex; f <= kLittle; ++f) {
+    const Vector3d& base = m.fingers_[static_cast<size_t>(f)].base;
+    ModelGaussian g;
+    g.bone = kPalmBone;
+    g.palm_position = {base.x(), base.y() - kKnuckleDropMm * scale.length, 0.0};
+    g.sigma_mm = (f == kLittle ? 8.0 : 9.0) * scale.sigma;
+    g.label = kPalm;
+    m.gaussians_.push_back(g);
+  }
   // Palm: three rows from the wrist to below the knuckles; sigma = half the palm thickness.
   struct PalmSpot {
     double x, y, sigma;

@@ -112,6 +112,10 @@ std::optional<Background> parse_background(std::string_view name) {
   return std::nullopt;
 }
 
+Background default_background(std::string_view motion, View view) {
+  return seen_in(motion, view) == View::kHeadMounted ? Background::kTable : Background::kBody;
+}
+
 std::string_view handedness_name(Handedness hand) { return hand == Handedness::kLeft ? "left" : "right"; }
 
 std::optional<Handedness> parse_handedness(std::string_view name) {
@@ -484,7 +488,7 @@ SynthOptions live_camera_options(const std::string& motion, int frames, uint64_t
   o.frames = frames;
   o.seed = seed;
   o.noise = true;
-  o.background = Background::kBody;
+  o.background = default_background(motion, o.view);
   o.camera = default_camera();
   o.camera.fps = fps;
   return o;

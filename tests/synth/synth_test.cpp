@@ -856,6 +856,17 @@ TEST(SynthTwoHands, InTwoReachAHeadsetSeesBothBacksWithTheRightHandOnTheRight) {
   }
 }
 
+// Each motion over the background its camera looks at, in handtrack-synth and in handtrackd's
+// synthetic source alike: a head-mounted camera (two_reach's) a table, a camera facing the user the
+// body.
+TEST(SynthBackgrounds, EachScenesCameraLooksAtItsOwnBackground) {
+  EXPECT_EQ(default_background("pinch", View::kHeadMounted), Background::kTable);
+  EXPECT_EQ(default_background("pinch", View::kBack), Background::kBody);
+  EXPECT_EQ(live_camera_options("two_reach", 300, 1, 60).background, Background::kTable);
+  EXPECT_EQ(live_camera_options("two_apart", 300, 1, 60).background, Background::kBody);
+  EXPECT_EQ(live_camera_options("flexex1", 300, 1, 60).background, Background::kBody);
+}
+
 // Hands may touch (two_clap: the palms meet) but never pass through each other; apart they stay
 // apart.
 TEST(SynthTwoHands, HandsTouchButNeverPassThroughEachOther) {

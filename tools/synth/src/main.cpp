@@ -248,11 +248,8 @@ int main(int argc, char** argv) {
   }
   const auto arrangement = handtrack::synth::parse_view(view);
   if (!arrangement) return fail("unknown view '" + view + "' (see --list-views)");
-  // A head-mounted camera looks down at a table (a two-hand scene: its own arrangement).
-  if (background.empty()) {
-    background = handtrack::synth::seen_in(motion, *arrangement) == handtrack::synth::View::kHeadMounted ? "table" : "body";
-  }
-  const auto bg = handtrack::synth::parse_background(background);
+  const auto bg = background.empty() ? handtrack::synth::default_background(motion, *arrangement)
+                                      : handtrack::synth::parse_background(background);
   if (!bg) return fail("--background must be body, table, desk, near-body or none, got '" + background + "'");
   const auto handedness = handtrack::synth::parse_handedness(hand);
   if (!handedness) return fail("--hand must be right or left, got '" + hand + "'");

@@ -60,7 +60,7 @@ struct CollisionPair {
 
 class HandModel {
  public:
-  // The default adult right hand (39 Gaussians), optionally scaled.
+  // The default adult right hand (43 Gaussians), optionally scaled.
   static HandModel default_adult(const HandScale& scale = {});
 
   [[nodiscard]] const std::array<FingerChain, kNumFingers>& fingers() const { return fingers_; }

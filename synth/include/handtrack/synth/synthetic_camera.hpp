@@ -40,6 +40,10 @@ enum class Background {
 };
 std::string_view background_name(Background background);
 std::optional<Background> parse_background(std::string_view name);
+// The background `motion` seen in `view` is rendered over unless told otherwise: a head-mounted
+// camera looks down at a table (a two-hand motion: in its own arrangement, seen_in), any other
+// arrangement at the user's body behind the hand.
+Background default_background(std::string_view motion, View view);
 
 // Which hand is shown. The hand model is a right hand; a left hand is its mirror image about the
 // camera's x = 0 plane, which a pinhole camera sees exactly as the right hand's image flipped left
@@ -75,8 +79,8 @@ struct SynthOptions {
 };
 
 // The virtual camera as handtrackd's `synthetic[:MOTION]` source shows it: `frames` per pass of
-// `motion`, subject and noise from `seed`, noise on, a body behind the hand, default_camera() at
-// `fps`. Tests render the daemon's frames (and their ground truth) with the same options.
+// `motion`, subject and noise from `seed`, noise on, over its default background (a body behind the
+// hand; two_reach's table), default_camera() at `fps`. Tests render the daemon's frames (and their ground truth) with the same options.
 SynthOptions live_camera_options(const std::string& motion, int frames, uint64_t seed, int fps);
 
 // The ground truth of one hand in a frame.
