@@ -43,6 +43,15 @@ with open(out) as f:
     only = json.load(f)
 if sorted(only) != ["late_fusion_2p_10it"]:
     failures.append(f"--only late_fusion_2p_10it measured {sorted(only)}")
+# The scenes' subject: 7 unless --seed says another.
+if table["late_fusion_2p_10it"].get("seed") != 7:
+    failures.append(f"default seed {table['late_fusion_2p_10it'].get('seed')!r}, not 7")
+subprocess.run([exe, "--frames", "10", "--seed", "3", "--only", "late_fusion_2p_10it", "--json", out], check=True,
+               stdout=subprocess.DEVNULL)
+with open(out) as f:
+    seeded = json.load(f)
+if seeded["late_fusion_2p_10it"].get("seed") != 3:
+    failures.append(f"--seed 3 measured seed {seeded['late_fusion_2p_10it'].get('seed')!r}")
 bad = subprocess.run([exe, "--only", "no_such_configuration"], capture_output=True, text=True)
 if bad.returncode == 0 or len(bad.stderr.strip().splitlines()) != 1 or "no_such_configuration" not in bad.stderr:
     failures.append(f"--only no_such_configuration: exit {bad.returncode}, stderr {bad.stderr!r}")

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -41,12 +42,12 @@ struct BenchConfig {
   bool background_checks = false;      // TrackerConfig's: checks on a thread of their own
 };
 
-// Renders `frames` depth frames of `motion` (seed 7, noise, 320x240).
-std::vector<DepthImage> render(const std::string& motion, int frames, CameraIntrinsics* camera) {
+// Renders `frames` depth frames of `motion` by subject `seed` (noise, 320x240).
+std::vector<DepthImage> render(const std::string& motion, int frames, uint64_t seed, CameraIntrinsics* camera) {
   synth::SynthOptions options;
   options.motion = motion;
   options.frames = frames;
-  options.seed = 7;
+  options.seed = seed;
   synth::SyntheticCamera synthetic(options);
   *camera = synthetic.camera();
   std::vector<DepthImage> input;
@@ -73,12 +74,16 @@ int main(int argc, char** argv) {
   std::string motion = "random";
   std::string two_hand_motion = "two_apart";
   int frames = 300;
+  uint64_t seed = 7;
   std::vector<std::string> only;
   app.add_option("--json", json_file, "write the table as JSON (SPEC.md)");
   app.add_option("--forest", forest_file, "part forest for the late-fusion configuration")->check(CLI::ExistingFile);
   app.add_option("--motion", motion, "synthetic motion to track");
   app.add_option("--two-hand-motion", two_hand_motion, "synthetic two-hand scene of the two-hand configurations");
   app.add_option("--frames", frames, "frames per configuration")->check(CLI::Range(10, 100000));
+  app.add_option("--seed", seed,
+                 "subject of the synthetic scenes (hand size, noise; default 7): the search frames a scene draws "
+                 "move the fps, so compare a change over several");
   app.add_option("--only", only, "measure only these configurations (by name; default: all)");
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
 
@@ -111,7 +116,7 @@ int main(int argc, char** argv) {
       const bool tracked = std::any_of(configs.begin(), configs.end(), [&](const BenchConfig& bc) {
         return measured(bc) && bc.two_hand_input == two_hand_scene;
       });
-      return tracked ? render(scene, frames, &camera) : std::vector<DepthImage>{};
+      return tracked ? render(scene, frames, seed, &camera) : std::vector<DepthImage>{};
     };
     const std::vector<DepthImage> one_hand = frames_of(false, motion);
     const std::vector<DepthImage> two_hands = frames_of(true, two_hand_motion);
@@ -182,7 +187,8 @@ int main(int argc, char** argv) {
                       {"hand_overlap", overlap},
                       {"width", camera.width},
                       {"height", camera.height},
-                      {"frames", frames}};
+                      {"frames", frames},
+                      {"seed", seed}};
       std::printf("%-48s %8.1f %14.2f %12.2f %9.2f/%.2f %8.2f\n", bc.name.c_str(), fps, pre, opt, p50, p99, overlap);
     }
     progress.done();
