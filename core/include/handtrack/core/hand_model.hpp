@@ -73,9 +73,9 @@ class HandModel {
   [[nodiscard]] double self_similarity() const { return self_similarity_; }
   // Hand-frame point at the centre of the palm (used for initialisation).
   [[nodiscard]] Eigen::Vector3d palm_centre() const;
-  // Half the palm's thickness (its top row's sigma, the last Gaussian) and half its width (from its centre line to
-  // the outer edge of its outermost Gaussian), mm: how far the palm centre lies behind the surface
-  // seen with the palm or the back, and with an edge, toward the camera.
+  // Half the palm's thickness (its top row's sigma, the last Gaussian) and half its width (from
+  // its centre line to the outer edge of its outermost Gaussian), mm: how far the palm centre lies
+  // behind the surface seen with the palm or the back, and with an edge, toward the camera.
   [[nodiscard]] double palm_half_thickness_mm() const;
   [[nodiscard]] double palm_half_width_mm() const;
   // Length from the wrist to the middle fingertip, mm.

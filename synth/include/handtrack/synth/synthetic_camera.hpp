@@ -80,7 +80,8 @@ struct SynthOptions {
 
 // The virtual camera as handtrackd's `synthetic[:MOTION]` source shows it: `frames` per pass of
 // `motion`, subject and noise from `seed`, noise on, over its default background (a body behind the
-// hand; two_reach's table), default_camera() at `fps`. Tests render the daemon's frames (and their ground truth) with the same options.
+// hand; two_reach's table), default_camera() at `fps`. Tests render the daemon's frames (and their
+// ground truth) with the same options.
 SynthOptions live_camera_options(const std::string& motion, int frames, uint64_t seed, int fps);
 
 // The ground truth of one hand in a frame.
