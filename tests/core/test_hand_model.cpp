@@ -23,11 +23,11 @@ std::vector<ModelGaussian> palm_of(const HandModel& model) {
   return palm;
 }
 
-// How far `point` (hand frame) lies into the palm's surface: the least distance to a palm
+// How far `point` (hand frame) lies into the surface of `palm`: the least distance to a palm
 // Gaussian's mean in units of its sigma (<= 1: on or inside its 1-sigma sphere, the skin).
-double palm_depth_in_sigmas(const HandModel& model, const Eigen::Vector3d& point) {
+double palm_depth_in_sigmas(const std::vector<ModelGaussian>& palm, const Eigen::Vector3d& point) {
   double least = std::numeric_limits<double>::infinity();
-  for (const ModelGaussian& g : palm_of(model)) least = std::min(least, (point - g.palm_position).norm() / g.sigma_mm);
+  for (const ModelGaussian& g : palm) least = std::min(least, (point - g.palm_position).norm() / g.sigma_mm);
   return least;
 }
 
@@ -39,12 +39,13 @@ double palm_depth_in_sigmas(const HandModel& model, const Eigen::Vector3d& point
 TEST(HandModel, ThePalmsSurfaceReachesEachFingersBase) {
   for (const HandScale& scale : kScales) {
     const HandModel model = HandModel::default_adult(scale);
+    const std::vector<ModelGaussian> palm = palm_of(model);
     const double palm_middle_y = model.palm_centre().y();
     for (int f = kIndex; f <= kLittle; ++f) {
       const Eigen::Vector3d base = model.fingers()[static_cast<size_t>(f)].base;
       for (double y = palm_middle_y; y <= base.y(); y += 1.0) {
         const Eigen::Vector3d point(base.x(), y, 0.0);
-        EXPECT_LE(palm_depth_in_sigmas(model, point), 1.3)
+        EXPECT_LE(palm_depth_in_sigmas(palm, point), 1.3)
             << kFingerNames[static_cast<size_t>(f)] << " at y = " << y << " mm, scale length " << scale.length;
       }
     }
@@ -56,12 +57,12 @@ TEST(HandModel, ThePalmsSurfaceReachesEachFingersBase) {
 TEST(HandModel, FourKnucklesBelowTheFingersAndThePalmsThicknessItsRows) {
   for (const HandScale& scale : kScales) {
     const HandModel model = HandModel::default_adult(scale);
+    const std::vector<ModelGaussian> palm = palm_of(model);
     EXPECT_EQ(model.gaussians().size(), 43U);
-    EXPECT_EQ(palm_of(model).size(), 13U);
+    EXPECT_EQ(palm.size(), 13U);
     EXPECT_DOUBLE_EQ(model.palm_half_thickness_mm(), 13.0 * scale.sigma);
     for (int f = kIndex; f <= kLittle; ++f) {
       const Eigen::Vector3d base = model.fingers()[static_cast<size_t>(f)].base;
-      const auto palm = palm_of(model);
       const bool has_knuckle = std::any_of(palm.begin(), palm.end(), [&](const ModelGaussian& g) {
         const Eigen::Vector3d offset = base - g.palm_position;
         return g.palm_position.z() == 0.0 && std::abs(offset.x()) < 1e-9 && offset.y() > 5.0 && offset.y() < 15.0;

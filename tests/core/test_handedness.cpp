@@ -121,9 +121,7 @@ TEST_P(RealHands, Sr305FramesAreRightHandsAndTheirMirrorImagesTheOtherHand) {
   const std::vector<fs::path> files = sr305_frames();
   if (files.empty()) GTEST_SKIP() << "shared data absent: " << kSr305Root;
   const TrackerConfig config = sr305_config(GetParam().mode);
-  std::optional<PartForest> forest;
-  if (config.mode == EnergyMode::kLateFusion) forest.emplace(PartForest::load(shipped_forest_path().value()));
-  const PixelLabeller* labeller = forest ? &*forest : nullptr;
+  const PixelLabeller* labeller = config.mode == EnergyMode::kLateFusion ? &testing::shipped_forest() : nullptr;
   int frames = 0;
   int right_hands = 0;
   for (const fs::path& file : files) {
@@ -218,7 +216,7 @@ StillFrames still_frames(const std::vector<fs::path>& files, Shown&& shown) {
 TEST(RealStillHand, StaysTheRightHandWhileTracked) {
   const std::vector<fs::path> files = sr305_frames();
   if (files.empty()) GTEST_SKIP() << "shared data absent: " << kSr305Root;
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const PartForest& forest = testing::shipped_forest();
   const StillFrames still = still_frames(files, [&](const std::vector<DepthImage>& frames) -> std::optional<Handedness> {
     Tracker tracker(sr305_config(EnergyMode::kLateFusion));
     TrackerOutput out;
@@ -240,7 +238,7 @@ TEST(RealStillHand, StaysTheRightHandWhileTracked) {
 TEST(RealStillHand, MostStayTheRightHandAsHandtrackdTracksThem) {
   const std::vector<fs::path> files = sr305_frames();
   if (files.empty()) GTEST_SKIP() << "shared data absent: " << kSr305Root;
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const PartForest& forest = testing::shipped_forest();
   TrackerConfig config = sr305_config(EnergyMode::kLateFusion);
   config.max_hands = 1;
   const StillFrames still = still_frames(files, [&](const std::vector<DepthImage>& frames) -> std::optional<Handedness> {

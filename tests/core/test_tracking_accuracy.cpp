@@ -82,7 +82,7 @@ std::vector<double> motion_means(const std::vector<eval::SequenceScore>& scores)
 }
 
 TEST(TrackingAccuracy, SevenSyntheticMotionsDepthOnlyAndLateFusion2Particles10Iterations) {
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const PartForest& forest = testing::shipped_forest();
   std::vector<eval::SequenceScore> depth_only;
   std::vector<eval::SequenceScore> late_fusion;
   std::vector<eval::SequenceScore> shipped;

@@ -105,7 +105,7 @@ std::vector<int> knock_off_and_track(std::string_view motion, const TrackerConfi
 constexpr int kMostKnocksNotBack = 3;
 
 TEST(TrackingRecovery, BackWithin30FramesAfterAGrossError) {
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const PartForest& forest = testing::shipped_forest();
   std::mt19937_64 rng(4);
   int not_back = 0;
   for (const uint64_t seed : testing::kSubjectSeeds) {
@@ -128,7 +128,7 @@ TEST(TrackingRecovery, BackWithin30FramesAfterAGrossError) {
 // without 2 of 6. (flexex1 is left out: a check shortly before its knock at frame 60 made the
 // recheck wait 24 frames, by design up to 30.)
 TEST(TrackingRecovery, AMediocreFitIsRecheckedThoughItsConfidenceNeverFell) {
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const PartForest& forest = testing::shipped_forest();
   TrackerConfig config = testing::paper_config(EnergyMode::kLateFusion);
   config.suspect_confidence_ratio = 0.0;
   config.recheck_interval_frames = 30;
@@ -183,7 +183,7 @@ int latency_knocks_back(
 // within 30 frames, where checks made at once have it back after 2 (the test fails with
 // check_iterations_per_frame 0: the frames after the knocks stall on whole searches).
 TEST(TrackingRecovery, ChecksSpreadOverFramesKeepEveryFrameShortAndStillRepairAGrossError) {
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const PartForest& forest = testing::shipped_forest();
   TrackerConfig config = testing::paper_config(EnergyMode::kLateFusion);
   config.handedness = HandednessMode::kRight;
   config.check_iterations_per_frame = 64;
@@ -220,7 +220,7 @@ TEST(TrackingRecovery, ChecksSpreadOverFramesKeepEveryFrameShortAndStillRepairAG
 // 63 knocks of BackWithin30FramesAfterAGrossError with background checks all are back (3 not when
 // last measured before the knuckles), with checks at once 62.
 TEST(TrackingRecovery, ChecksInTheBackgroundKeepEveryFrameShortAndStillRepairAGrossError) {
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const PartForest& forest = testing::shipped_forest();
   TrackerConfig config = testing::paper_config(EnergyMode::kLateFusion);
   config.handedness = HandednessMode::kRight;
   config.background_checks = true;
@@ -263,7 +263,7 @@ TEST(TrackingRecovery, HandLeavingTheWorkingVolumeIsNoHandAndIsFoundAgain) {
   constexpr double kStepMm = 15.0;      // away per frame, then back
   constexpr int kAwayFrames = 40;       // 600 mm further: the whole hand (and forearm) beyond 600 mm
   constexpr int kTotalFrames = kApproachFrames + 2 * kAwayFrames + kRecoveryFrames;
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const PartForest& forest = testing::shipped_forest();
   Tracker tracker(testing::paper_config(EnergyMode::kLateFusion));
   auto camera = testing::motion_camera("fingerwave");
   const double far_mm = tracker.pose_tracker().config().input.far_mm;

@@ -85,7 +85,7 @@ class EveryView : public ::testing::TestWithParam<ViewCase> {};
 
 TEST_P(EveryView, TrackedAsTheHandItIs) {
   const ViewCase& c = GetParam();
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const PartForest& forest = testing::shipped_forest();
   const testing::OneHandRun run = track_subjects(c, forest, kSeeds);
   const std::string name = std::string(c.motion) + " " + std::string(synth::view_name(c.view)) + " " +
                            std::string(synth::handedness_name(c.hand)) +
@@ -170,7 +170,7 @@ INSTANTIATE_TEST_SUITE_P(HoldingABall, EveryView,
 // through the hand's plane"). Measured: 810 of 960 frames (84 %), 14.7 mm; before that rule 433
 // of 960 (45 %), 19.3 mm.
 TEST(FlatHandFromTheBack, MostFramesAreTheHandItIs) {
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const PartForest& forest = testing::shipped_forest();
   constexpr std::array<uint64_t, 4> kFlatSeeds = {21, 22, 23, 24};
   testing::OneHandRun both;
   for (const synth::Handedness hand : {synth::Handedness::kRight, synth::Handedness::kLeft}) {
@@ -188,7 +188,7 @@ TEST(FlatHandFromTheBack, MostFramesAreTheHandItIs) {
 // on three subjects w_u was not measured on (docs/TRACKER.md, "Unseen fingers curl"). Measured:
 // 26.4 mm with it, 30.2 mm without (better on five of the six sequences).
 TEST(FistsFromTheBack, FingersTheCameraCannotSeeCurl) {
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const PartForest& forest = testing::shipped_forest();
   const TrackerConfig without = without_unseen_fingers();
   testing::OneHandRun with_prior;
   testing::OneHandRun without_prior;
@@ -208,7 +208,7 @@ TEST(FistsFromTheBack, FingersTheCameraCannotSeeCurl) {
 // hand: the fists from the back are then tracked exactly as with w_u = 0, while alone the same
 // frames are tracked otherwise (so the prior acts on them and the first comparison can fail).
 TEST(FistsFromTheBack, NoCurlBesideAnotherHand) {
-  const PartForest forest = PartForest::load(shipped_forest_path().value());
+  const PartForest& forest = testing::shipped_forest();
   synth::SynthOptions options;
   options.motion = "flexex1";
   options.view = synth::View::kBack;
