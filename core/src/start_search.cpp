@@ -35,18 +35,6 @@ constexpr size_t kMaxStarts = 2 * kStartsPerPlane;
 // the angle out of the image plane: 45 deg) is also started with its fingers along that axis in 3D:
 // a hand reaching forward under a head-mounted camera, fingers pointing at a desk camera.
 constexpr double kOutOfPlaneAxisMinZ = 0.7;
-bool out_of_image_plane(const HandPlace& place) { return std::abs(place.finger_axis.z()) >= kOutOfPlaneAxisMinZ; }
-// A fist with its fingers toward the camera shows a round blob whose segmented axis lies in the
-// image plane and may point either way (toward the forearm or from it), and the closed hypotheses,
-// with their fingers in that plane, start 44-57 mm from it; with the search's E_col they end
-// 35-90 mm off (fingercount seen fingers-toward: docs/TRACKER.md, "A fist at a (re)start"). So
-// where the axis lies in the image plane, four more closed hands: palm or back toward the camera,
-// at either end of the axis, tipped kFistTipRad toward the camera (0.6, 0.9 and 1.2 rad ended
-// 17.5, 16.5 and 16.9 mm off on fingercount's first frame, seed 1). Not where the axis points out
-// of the image plane: there the along-axis hypotheses cover it, and tipped fists won the
-// head-mounted view's fists in wrong poses (flexex1 head-mounted right s3: 37.6 -> 63.1 mm).
-constexpr double kFistTipRad = -0.9;
-constexpr size_t kTippedFists = 4;
 // Closed hand: [abd, flex1, flex2, flex3] for the thumb, then for each finger.
 constexpr std::array<double, 4> kClosedThumb = {0.3, 0.6, 0.5, 0.5};
 constexpr std::array<double, 4> kClosedFinger = {0.0, 1.3, 1.5, 0.9};
@@ -93,19 +81,11 @@ void StartSearch::set_scale(const HandScale& scale) {
 }
 
 
-StartHypothesis StartSearch::hypothesis(const HandPlace& place, size_t k) {
+StartHypothesis StartSearch::hypothesis(size_t k) {
   // Hypothesis k: by plane (the image's, then along the 3D axis), turn, closed, and in-plane
-  // rotation, the last changing fastest; or, after the image plane's, a tipped fist.
-  StartHypothesis start;
-  if (k >= kStartsPerPlane && !out_of_image_plane(place)) {
-    const size_t t = k - kStartsPerPlane;
-    start.closed = true;
-    start.turn_rad = t % 2 == 0 ? 0.0 : std::numbers::pi;
-    start.in_plane_offset_rad = t / 2 == 0 ? 0.0 : std::numbers::pi;
-    start.tip_rad = kFistTipRad;
-    return start;
-  }
+  // rotation, the last changing fastest.
   const size_t in_plane = k % kStartsPerPlane;
+  StartHypothesis start;
   start.along_axis_3d = k >= kStartsPerPlane;
   start.turn_rad = kStartTurns[in_plane / (kStartClosed.size() * kStartRotations.size())];
   start.closed = kStartClosed[(in_plane / kStartRotations.size()) % kStartClosed.size()];
@@ -114,7 +94,7 @@ StartHypothesis StartSearch::hypothesis(const HandPlace& place, size_t k) {
 }
 
 size_t StartSearch::hypothesis_count(const HandPlace& place) {
-  return out_of_image_plane(place) ? kMaxStarts : kStartsPerPlane + kTippedFists;
+  return std::abs(place.finger_axis.z()) >= kOutOfPlaneAxisMinZ ? kMaxStarts : kStartsPerPlane;
 }
 
 PoseParams StartSearch::initial_pose(const HandPlace& place, const StartHypothesis& start) const {
@@ -134,11 +114,6 @@ PoseParams StartSearch::initial_pose(const HandPlace& place, const StartHypothes
     const Vector3d in_plane = turn * Vector3d(0, -1, 0);
     const Vector3d along = (Eigen::AngleAxisd(start.in_plane_offset_rad, Vector3d::UnitZ()) * axis).normalized();
     turn = Eigen::Quaterniond::FromTwoVectors(in_plane, along).toRotationMatrix() * turn;
-  }
-  if (start.tip_rad != 0.0) {
-    // About f x z, f the fingers' direction (in the image plane): f -> f cos(tip) + z sin(tip).
-    const Vector3d fingers = turn * Vector3d(0, -1, 0);
-    turn = Eigen::AngleAxisd(start.tip_rad, fingers.cross(Vector3d::UnitZ()).normalized()).toRotationMatrix() * turn;
   }
   params.segment<3>(kRotationParam) = rotation_log(turn);
   if (start.closed) {
@@ -250,7 +225,7 @@ const PoseEnergy& StartSearch::start_energy(const DepthInput& input) const {
 }
 
 void StartSearch::screen(const DepthInput& input, const HandPlace& place, size_t k) {
-  screened_.push_back(fit_from(input, initial_pose(place, hypothesis(place, k)), std::min(kScreenIterations, init_iterations_),
+  screened_.push_back(fit_from(input, initial_pose(place, hypothesis(k)), std::min(kScreenIterations, init_iterations_),
                                start_energy(input)));
 }
 

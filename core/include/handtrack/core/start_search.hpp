@@ -57,8 +57,6 @@ struct StartHypothesis {
   // (the thumb's or the little finger's edge) toward it.
   double turn_rad = 0.0;
   bool along_axis_3d = false;        // fingers along the segmented axis in 3D, not in the image plane
-  // Then tipped about the image-plane axis across the fingers: negative toward the camera.
-  double tip_rad = 0.0;
 };
 
 class StartSearch {
@@ -82,7 +80,7 @@ class StartSearch {
     return fit_from(input, from, iterations, start_energy(input));
   }
   // The same in pieces, for a search spread over frames: forget the last search, the number of
-  // hypotheses at `place` (28, or 48 for a hand out of the image plane), screen the k-th, keep the
+  // hypotheses at `place` (24, or 48 for a hand out of the image plane), screen the k-th, keep the
   // best screened, refine the kept ones `iterations` further (the best of them).
   void clear() { screened_.clear(); }
   static size_t hypothesis_count(const HandPlace& place);
@@ -103,7 +101,7 @@ class StartSearch {
   int take_iterations() { return std::exchange(iterations_, 0); }
 
  private:
-  static StartHypothesis hypothesis(const HandPlace& place, size_t k);
+  static StartHypothesis hypothesis(size_t k);
   StartFit fit_from(const DepthInput& input, const PoseParams& from, int iterations, const PoseEnergy& with);
   [[nodiscard]] const PoseEnergy& start_energy(const DepthInput& input) const;
 
