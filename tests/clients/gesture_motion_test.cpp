@@ -3,10 +3,11 @@
 // starts each count from a fist with the index alone (pointing). The events from the tracker's
 // poses must come at the frames where the same gestures happen in the ground truth (its joints
 // through the same library), neither missed nor doubled: every pinch of the pinch motion, and
-// the fists of flexex1's slow half for two subjects of three. In the fast half the tracker does not close its fists (grab
-// strength peaks at 0.6-0.76 where the truth reaches 1) and at the start of fingercount it does not
-// find the initial fist: docs/GESTURES.md has the figures; those are tracker limits (the issue
-// "Every hand, every view"), so there only the ground truth's events are checked.
+// the fists of flexex1's slow half for two subjects of three. In the fast half the tracker does
+// not close its fists (grab strength peaks at 0.6-0.76 where the truth reaches 1) and at the start
+// of fingercount it does not find the initial fist: docs/GESTURES.md has the figures; those are
+// tracker limits (the issue "Every hand, every view"), so there only the ground truth's events are
+// checked.
 #include "handtrack/core/tracker.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
 
@@ -114,7 +115,7 @@ void expect_same_events(const std::string& motion, int gesture, int frames, int 
     not_followed += same_events(tracked, truth, tolerance) ? 0 : 1;
   }
   EXPECT_LE(not_followed, most_not_followed) << motion << ": subjects whose " << handtrack_gesture_name(gesture)
-                                 << " the tracker did not follow";
+                                             << " the tracker did not follow";
 }
 
 // Within 200 ms (the first pinch starts 3-6 frames late while the tracker settles; the others 0-3).

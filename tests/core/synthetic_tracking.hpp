@@ -63,6 +63,13 @@ struct OneHandRun {
   }
 };
 
+// The mean distance of a tracked pose's fingertips from the frame's true ones, mm.
+inline double fingertip_error_mm(const TrackerOutput& out, const synth::SynthFrame& frame) {
+  double e = 0.0;
+  for (size_t t = 0; t < kNumFingers; ++t) e += (out.fingertips[t] - *frame.fingertips[t]).norm();
+  return e / kNumFingers;
+}
+
 inline OneHandRun track_one_hand(const synth::SynthOptions& options, const TrackerConfig& config,
                                  const PixelLabeller* labeller = nullptr, int from_frame = 0) {
   synth::SyntheticCamera camera(options);
@@ -76,9 +83,7 @@ inline OneHandRun track_one_hand(const synth::SynthOptions& options, const Track
     if (i < from_frame || out.state == TrackingState::kNoHand) continue;
     ++run.posed;
     run.reported_as_shown += out.handedness == shown ? 1 : 0;
-    double e = 0.0;
-    for (size_t t = 0; t < kNumFingers; ++t) e += (out.fingertips[t] - *frame.fingertips[t]).norm();
-    run.error_sum_mm += e / kNumFingers;
+    run.error_sum_mm += fingertip_error_mm(out, frame);
   }
   return run;
 }
