@@ -5,6 +5,7 @@
 #include "handtrack/core/tracker.hpp"
 
 #include <Eigen/Geometry>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <array>
@@ -35,6 +36,27 @@ constexpr size_t kMaxStarts = 2 * kStartsPerPlane;
 // the angle out of the image plane: 45 deg) is also started with its fingers along that axis in 3D:
 // a hand reaching forward under a head-mounted camera, fingers pointing at a desk camera.
 constexpr double kOutOfPlaneAxisMinZ = 0.7;
+bool out_of_image_plane(const HandPlace& place) { return std::abs(place.finger_axis.z()) >= kOutOfPlaneAxisMinZ; }
+// A fist seen along its fingers (toward or away from the camera) shows a round blob whose
+// segmented axis lies in the image plane and may point either way (toward the forearm or from
+// it), and the closed hypotheses, with their fingers in that plane, start far from it: with the
+// fingers toward the camera 44-57 mm, and with the search's E_col they end 35-90 mm off
+// (fingercount: docs/TRACKER.md, "A fist at a (re)start"). So where the axis lies in the image
+// plane and the hand is no longer than a fist, eight more closed hands: palm or back toward the
+// camera, at either end of the axis, tipped kFistTipRad toward or away from the camera (toward:
+// 0.6, 0.9 and 1.2 rad ended 17.5, 16.5 and 16.9 mm off on fingercount's first frame, seed 1; away
+// the same angle, not scanned). Not where the axis points out of the image plane: there the
+// along-axis hypotheses cover it, and tipped fists won the head-mounted view's fists in wrong poses
+// (flexex1 head-mounted right s3: 37.6 -> 63.1 mm). Not for a longer hand: tipped fists of the
+// wrong hand won flat open real hands (SR305 frame 231615/40 turned to the left hand).
+constexpr double kFistTipRad = 0.9;
+constexpr size_t kTippedFists = 8;
+// A hand is no longer than a fist where its length in the image plane (StartSearch::place) is at
+// most this, times the model's length scale: an adult fist from the wrist to the knuckles is about
+// 100-110 mm. Measured lengths on fingercount's first frame (a fist; seeds 1-3): 87-90 mm seen
+// along the fingers toward the camera, 94-102 away from it, 95-110 from the back, 109-122 from the
+// side; open hands seen flat 140-176 mm; the real SR305 hands 131-157 mm.
+constexpr double kFistLengthMm = 115.0;
 // Closed hand: [abd, flex1, flex2, flex3] for the thumb, then for each finger.
 constexpr std::array<double, 4> kClosedThumb = {0.3, 0.6, 0.5, 0.5};
 constexpr std::array<double, 4> kClosedFinger = {0.0, 1.3, 1.5, 0.9};
@@ -81,11 +103,20 @@ void StartSearch::set_scale(const HandScale& scale) {
 }
 
 
-StartHypothesis StartSearch::hypothesis(size_t k) {
+StartHypothesis StartSearch::hypothesis(const HandPlace& place, size_t k) {
   // Hypothesis k: by plane (the image's, then along the 3D axis), turn, closed, and in-plane
-  // rotation, the last changing fastest.
-  const size_t in_plane = k % kStartsPerPlane;
+  // rotation, the last changing fastest; or, after the image plane's, a tipped fist (turn, then
+  // end of the axis, then toward or away from the camera).
   StartHypothesis start;
+  if (k >= kStartsPerPlane && !out_of_image_plane(place)) {
+    const size_t t = k - kStartsPerPlane;
+    start.closed = true;
+    start.turn_rad = t % 2 == 0 ? 0.0 : std::numbers::pi;
+    start.in_plane_offset_rad = (t / 2) % 2 == 0 ? 0.0 : std::numbers::pi;
+    start.tip_rad = t < kTippedFists / 2 ? -kFistTipRad : kFistTipRad;
+    return start;
+  }
+  const size_t in_plane = k % kStartsPerPlane;
   start.along_axis_3d = k >= kStartsPerPlane;
   start.turn_rad = kStartTurns[in_plane / (kStartClosed.size() * kStartRotations.size())];
   start.closed = kStartClosed[(in_plane / kStartRotations.size()) % kStartClosed.size()];
@@ -94,7 +125,34 @@ StartHypothesis StartSearch::hypothesis(size_t k) {
 }
 
 size_t StartSearch::hypothesis_count(const HandPlace& place) {
-  return std::abs(place.finger_axis.z()) >= kOutOfPlaneAxisMinZ ? kMaxStarts : kStartsPerPlane;
+  if (out_of_image_plane(place)) return kMaxStarts;
+  return place.fist_sized ? kStartsPerPlane + kTippedFists : kStartsPerPlane;
+}
+
+HandPlace StartSearch::place(const DepthInput& input) const {
+  // The hand's length in the image plane: the spread of its points (x, y in mm) along their
+  // principal direction, times sqrt(12), the length of a uniform bar with that spread.
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d sum_sq = Eigen::Matrix2d::Zero();
+  int pixels = 0;
+  const CameraIntrinsics& cam = input.camera;
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      const auto i = static_cast<size_t>(v) * static_cast<size_t>(cam.width) + static_cast<size_t>(u);
+      if (input.hand_mask[i] == 0 || input.filtered_mm[i] <= 0.0F) continue;
+      const Eigen::Vector2d p = cam.unproject(u, v, input.filtered_mm[i]).head<2>();
+      sum += p;
+      sum_sq += p * p.transpose();
+      ++pixels;
+    }
+  }
+  double length_mm = 0.0;
+  if (pixels > 0) {
+    const Eigen::Vector2d mean = sum / pixels;
+    const Eigen::Matrix2d cov = sum_sq / pixels - mean * mean.transpose();
+    length_mm = std::sqrt(12.0 * std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvalues()(1)));
+  }
+  return {input.palm_centre_mm, input.finger_axis, length_mm <= kFistLengthMm * scale_.length};
 }
 
 PoseParams StartSearch::initial_pose(const HandPlace& place, const StartHypothesis& start) const {
@@ -114,6 +172,11 @@ PoseParams StartSearch::initial_pose(const HandPlace& place, const StartHypothes
     const Vector3d in_plane = turn * Vector3d(0, -1, 0);
     const Vector3d along = (Eigen::AngleAxisd(start.in_plane_offset_rad, Vector3d::UnitZ()) * axis).normalized();
     turn = Eigen::Quaterniond::FromTwoVectors(in_plane, along).toRotationMatrix() * turn;
+  }
+  if (start.tip_rad != 0.0) {
+    // About f x z, f the fingers' direction (in the image plane): f -> f cos(tip) + z sin(tip).
+    const Vector3d fingers = turn * Vector3d(0, -1, 0);
+    turn = Eigen::AngleAxisd(start.tip_rad, fingers.cross(Vector3d::UnitZ()).normalized()).toRotationMatrix() * turn;
   }
   params.segment<3>(kRotationParam) = rotation_log(turn);
   if (start.closed) {
@@ -225,7 +288,7 @@ const PoseEnergy& StartSearch::start_energy(const DepthInput& input) const {
 }
 
 void StartSearch::screen(const DepthInput& input, const HandPlace& place, size_t k) {
-  screened_.push_back(fit_from(input, initial_pose(place, hypothesis(k)), std::min(kScreenIterations, init_iterations_),
+  screened_.push_back(fit_from(input, initial_pose(place, hypothesis(place, k)), std::min(kScreenIterations, init_iterations_),
                                start_energy(input)));
 }
 
@@ -274,7 +337,7 @@ StartFit StartSearch::run(const DepthInput& input, const std::atomic<bool>* stop
   // (by fit score) get the rest of init_iterations. All hypotheses to the end cost 24-48 x 80
   // iterations, 40-100 ms on one frame at every start (and check made at once).
   clear();
-  const HandPlace place{input.palm_centre_mm, input.finger_axis};
+  const HandPlace place = this->place(input);
   for (size_t k = 0; k < hypothesis_count(place); ++k) {
     if (stop != nullptr && stop->load(std::memory_order_relaxed)) return {};
     screen(input, place, k);

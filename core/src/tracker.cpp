@@ -494,7 +494,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
       // The hypotheses are placed on this frame's hand, segmented afresh (hint()), not where the
       // doubted pose says; the later frames of the check are segmented with the hint again (a
       // fresh segmentation on each of them lost the hand in one of them: docs/TRACKER.md).
-      const HandPlace place{input.palm_centre_mm, input.finger_axis};
+      const HandPlace place = search_.place(input);
       check_ = Check{true, next_check_, place, input.hand_centroid_mm, StartSearch::hypothesis_count(place), 0, 0, {}};
       search_.clear();
       next_check_ = CheckCause::kNone;

@@ -47,6 +47,8 @@ struct StartFit {
 struct HandPlace {
   Eigen::Vector3d palm_centre_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d finger_axis = Eigen::Vector3d(0, -1, 0);
+  // The segmented hand is no longer in the image plane than a fist (StartSearch::place).
+  bool fist_sized = false;
 };
 
 // One (re)start hypothesis: Sec. 5's open hand, or a closed one, placed at the segmented hand.
@@ -57,6 +59,9 @@ struct StartHypothesis {
   // (the thumb's or the little finger's edge) toward it.
   double turn_rad = 0.0;
   bool along_axis_3d = false;        // fingers along the segmented axis in 3D, not in the image plane
+  // Then tipped about the image-plane axis across the fingers: negative toward the camera,
+  // positive away from it.
+  double tip_rad = 0.0;
 };
 
 class StartSearch {
@@ -79,9 +84,11 @@ class StartSearch {
   StartFit fit(const DepthInput& input, const PoseParams& from, int iterations) {
     return fit_from(input, from, iterations, start_energy(input));
   }
-  // The same in pieces, for a search spread over frames: forget the last search, the number of
-  // hypotheses at `place` (24, or 48 for a hand out of the image plane), screen the k-th, keep the
-  // best screened, refine the kept ones `iterations` further (the best of them).
+  // The same in pieces, for a search spread over frames: where the hypotheses go on `input`'s
+  // segmented hand, forget the last search, the number of hypotheses at `place` (24, 32 for a hand
+  // no longer than a fist, 48 for a hand out of the image plane), screen the k-th, keep the best
+  // screened, refine the kept ones `iterations` further (the best of them).
+  [[nodiscard]] HandPlace place(const DepthInput& input) const;
   void clear() { screened_.clear(); }
   static size_t hypothesis_count(const HandPlace& place);
   void screen(const DepthInput& input, const HandPlace& place, size_t k);
@@ -101,7 +108,7 @@ class StartSearch {
   int take_iterations() { return std::exchange(iterations_, 0); }
 
  private:
-  static StartHypothesis hypothesis(size_t k);
+  static StartHypothesis hypothesis(const HandPlace& place, size_t k);
   StartFit fit_from(const DepthInput& input, const PoseParams& from, int iterations, const PoseEnergy& with);
   [[nodiscard]] const PoseEnergy& start_energy(const DepthInput& input) const;
 
