@@ -111,7 +111,7 @@ void BackgroundSearch::run() {
     // input_, other_ and scale_ stay as submit() left them until the state is idle again.
     search_.set_scale(scale_);
     search_.set_other_hand(has_other_ ? &other_ : nullptr);
-    result_ = search_.run(input_, &stop_);
+    result_ = search_.run(input_, SearchPurpose::kCheck, &stop_);
     search_.take_iterations();  // the tracking thread counts its own iterations only
     finished_searches.fetch_add(1, std::memory_order_relaxed);
     State running = State::kRunning;

@@ -129,7 +129,12 @@ size_t StartSearch::hypothesis_count(const HandPlace& place) {
   return place.fist_sized ? kStartsPerPlane + kTippedFists : kStartsPerPlane;
 }
 
-HandPlace StartSearch::place(const DepthInput& input) const {
+HandPlace StartSearch::place(const DepthInput& input, SearchPurpose purpose) const {
+  HandPlace place{input.palm_centre_mm, input.finger_axis, false};
+  // Tipped fists at (re)starts only: in checks of a tracked pose they won over fists seen from the
+  // back as they closed, whose tracking then walked off (flexex1 back left s4: 17.6 -> 34.6 mm;
+  // docs/TRACKER.md, "Fists tipped toward and away from the camera").
+  if (purpose == SearchPurpose::kCheck) return place;
   // The hand's length in the image plane: the spread of its points (x, y in mm) along their
   // principal direction, times sqrt(12), the length of a uniform bar with that spread.
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
@@ -152,7 +157,8 @@ HandPlace StartSearch::place(const DepthInput& input) const {
     const Eigen::Matrix2d cov = sum_sq / pixels - mean * mean.transpose();
     length_mm = std::sqrt(12.0 * std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvalues()(1)));
   }
-  return {input.palm_centre_mm, input.finger_axis, length_mm <= kFistLengthMm * scale_.length};
+  place.fist_sized = length_mm <= kFistLengthMm * scale_.length;
+  return place;
 }
 
 PoseParams StartSearch::initial_pose(const HandPlace& place, const StartHypothesis& start) const {
@@ -324,7 +330,7 @@ bool StartSearch::better(const StartFit& a, const StartFit& b) {
          (a.explained.score() > b.explained.score() - 1e-9 && a.result.energy > b.result.energy);
 }
 
-StartFit StartSearch::run(const DepthInput& input, const std::atomic<bool>* stop) {
+StartFit StartSearch::run(const DepthInput& input, SearchPurpose purpose, const std::atomic<bool>* stop) {
   // The hypotheses are compared by confidence, not energy: E_sim has no notion of occlusion, so
   // a wrong pose that pushes the big palm Gaussians onto the visible surface can out-score the right
   // one (seen on fists), while it explains little of the hand's outline. No temporal prior: the
@@ -337,7 +343,7 @@ StartFit StartSearch::run(const DepthInput& input, const std::atomic<bool>* stop
   // (by fit score) get the rest of init_iterations. All hypotheses to the end cost 24-48 x 80
   // iterations, 40-100 ms on one frame at every start (and check made at once).
   clear();
-  const HandPlace place = this->place(input);
+  const HandPlace place = this->place(input, purpose);
   for (size_t k = 0; k < hypothesis_count(place); ++k) {
     if (stop != nullptr && stop->load(std::memory_order_relaxed)) return {};
     screen(input, place, k);

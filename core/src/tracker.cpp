@@ -447,7 +447,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     // A (re)start: the frame of a whole search, where the background search's copies get their
     // room once (no allocation at its first check).
     if (background_) background_->reserve(input.camera.width, input.camera.height);
-    best = search_.run(input).result;
+    best = search_.run(input, SearchPurpose::kStart).result;
     started = true;
     recovering_ = true;
   } else {
@@ -494,7 +494,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
       // The hypotheses are placed on this frame's hand, segmented afresh (hint()), not where the
       // doubted pose says; the later frames of the check are segmented with the hint again (a
       // fresh segmentation on each of them lost the hand in one of them: docs/TRACKER.md).
-      const HandPlace place = search_.place(input);
+      const HandPlace place = search_.place(input, SearchPurpose::kCheck);
       check_ = Check{true, next_check_, place, input.hand_centroid_mm, StartSearch::hypothesis_count(place), 0, 0, {}};
       search_.clear();
       next_check_ = CheckCause::kNone;

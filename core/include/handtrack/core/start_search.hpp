@@ -47,9 +47,14 @@ struct StartFit {
 struct HandPlace {
   Eigen::Vector3d palm_centre_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d finger_axis = Eigen::Vector3d(0, -1, 0);
-  // The segmented hand is no longer in the image plane than a fist (StartSearch::place).
+  // At a (re)start, the segmented hand is no longer in the image plane than a fist
+  // (StartSearch::place): tipped fists are tried too.
   bool fist_sized = false;
 };
+
+// What a search is for: a (re)start, where there is no pose to go on, or a check of a tracked
+// pose, which a search's best replaces only where it explains the hand better.
+enum class SearchPurpose { kStart, kCheck };
 
 // One (re)start hypothesis: Sec. 5's open hand, or a closed one, placed at the segmented hand.
 struct StartHypothesis {
@@ -79,7 +84,7 @@ class StartSearch {
 
   // The whole search on one frame: every hypothesis screened, the best refined; the best fit.
   // `stop` (may be null) set: it returns at the next hypothesis with a fit to be dropped.
-  StartFit run(const DepthInput& input, const std::atomic<bool>* stop = nullptr);
+  StartFit run(const DepthInput& input, SearchPurpose purpose, const std::atomic<bool>* stop = nullptr);
   // One pose `iterations` further on `input` with the energy the hypotheses optimise.
   StartFit fit(const DepthInput& input, const PoseParams& from, int iterations) {
     return fit_from(input, from, iterations, start_energy(input));
@@ -88,7 +93,7 @@ class StartSearch {
   // segmented hand, forget the last search, the number of hypotheses at `place` (24, 32 for a hand
   // no longer than a fist, 48 for a hand out of the image plane), screen the k-th, keep the best
   // screened, refine the kept ones `iterations` further (the best of them).
-  [[nodiscard]] HandPlace place(const DepthInput& input) const;
+  [[nodiscard]] HandPlace place(const DepthInput& input, SearchPurpose purpose) const;
   void clear() { screened_.clear(); }
   static size_t hypothesis_count(const HandPlace& place);
   void screen(const DepthInput& input, const HandPlace& place, size_t k);
