@@ -294,8 +294,8 @@ const PoseEnergy& StartSearch::start_energy(const DepthInput& input) const {
 }
 
 void StartSearch::screen(const DepthInput& input, const HandPlace& place, size_t k) {
-  screened_.push_back(fit_from(input, initial_pose(place, hypothesis(place, k)), std::min(kScreenIterations, init_iterations_),
-                               start_energy(input)));
+  screened_.push_back(fit_from(input, initial_pose(place, hypothesis(place, k)),
+                               std::min(kScreenIterations, init_iterations_), start_energy(input)));
 }
 
 void StartSearch::keep_best(const DepthInput& input) {
