@@ -55,7 +55,8 @@ constexpr size_t kTippedFists = 8;
 // most this, times the model's length scale: an adult fist from the wrist to the knuckles is about
 // 100-110 mm. Measured lengths on fingercount's first frame (a fist; seeds 1-3): 87-90 mm seen
 // along the fingers toward the camera, 94-102 away from it, 95-110 from the back, 109-122 from the
-// side; open hands seen flat 140-176 mm; the real SR305 hands 131-157 mm.
+// side; open hands seen flat 140-176 mm; the 19 real SR305 hands 132-176 mm (two of them segmented
+// on their first frame as a 70-75 mm sliver).
 constexpr double kFistLengthMm = 115.0;
 // Closed hand: [abd, flex1, flex2, flex3] for the thumb, then for each finger.
 constexpr std::array<double, 4> kClosedThumb = {0.3, 0.6, 0.5, 0.5};
