@@ -270,7 +270,7 @@ double SimilarityTerm::evaluate(const HandModel& model, const PosedHand& hand, c
 }
 
 double SimilarityTerm::evaluate_centres(const HandModel& model, const PosedHand& hand, const DepthInput& input,
-                                        CentreGradients* dE_dcentres) const {
+                                        CentreGradients* dE_dcentres, const SurfaceFronts* fronts) const {
   if (input.gaussians.empty() || input.self_similarity <= 0.0) return 0.0;
   assert(input.mixture.size() == input.gaussians.size() && "DepthInput::mixture must be assigned");
   const auto& cam = input.camera;
@@ -290,7 +290,7 @@ double SimilarityTerm::evaluate_centres(const HandModel& model, const PosedHand&
   std::size_t kept_size = 0;
   if (capped) std::fill_n(coverage.covered, n, 0.0);
   // Each model Gaussian projected: u = fx x/z + cx, v = fy y/z + cy, sigma_p = sigma_h f/z,
-  // d_p = z - sigma_h; with a cap, its overlaps added to the coverage S_q.
+  // d_p = z - k_p sigma_h; with a cap, its overlaps added to the coverage S_q.
   std::array<ProjectedGaussian, kMaxModelGaussians> projected;
   std::array<ImageMixtureSlice, kMaxModelGaussians> slices{};
   for (int i = 0; i < hand.gaussian_count(); ++i) {
@@ -304,7 +304,7 @@ double SimilarityTerm::evaluate_centres(const HandModel& model, const PosedHand&
     p.v = cam.fy * mu.y() / z + cam.cy;
     p.sigma = sigma_h * f / z;
     p.sigma2 = p.sigma * p.sigma;
-    p.depth_mm = z - sigma_h;
+    p.depth_mm = z - (fronts != nullptr ? fronts->sigmas[static_cast<size_t>(i)] : 1.0) * sigma_h;
     p.reach_mm = by_label ? 2.0 * label_radius_mm_ : 2.0 * sigma_h;
     const double lo = p.depth_mm - p.reach_mm - kSliceMarginMm;
     const double hi = p.depth_mm + p.reach_mm + kSliceMarginMm;
@@ -557,10 +557,11 @@ double PoseEnergy::evaluate(const EnergyFrame& frame, const PoseParams& params, 
   PoseGradient g_smo = PoseGradient::Zero();
   const bool want = gradient != nullptr;
   EnergyBreakdown e;
-  e.similarity = similarity_.evaluate_centres(*frame.model, hand, *frame.input, want ? &g_sim : nullptr);
+  e.similarity = similarity_.evaluate_centres(*frame.model, hand, *frame.input, want ? &g_sim : nullptr, frame.fronts);
   if (factor_ == SimilarityFactor::kDepthAndLabel) {
     CentreGradients g_label = CentreGradients::Zero(3, n);
-    const double label = label_similarity_.evaluate_centres(*frame.model, hand, *frame.input, want ? &g_label : nullptr);
+    const double label =
+        label_similarity_.evaluate_centres(*frame.model, hand, *frame.input, want ? &g_label : nullptr, frame.fronts);
     e.similarity = (1.0 - label_share_) * e.similarity + label_share_ * label;
     g_sim = (1.0 - label_share_) * g_sim + label_share_ * g_label;
   }

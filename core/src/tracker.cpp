@@ -352,6 +352,7 @@ EnergyWeights mode_weights(const TrackerConfig& config) {
     weights.free_space = 0.0;
     weights.coverage_cap = 0.0;
     weights.unseen_fingers = 0.0;
+    weights.slant_front = 1.0;
   } else {
     weights.collision = config.weights.tracking_collision;
   }
@@ -437,6 +438,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
   if (!input.has_hand()) return no_hand();
   EnergyFrame frame{&model(), &input, nullptr, nullptr, other_hand_};
   UnseenFingers unseen;
+  SurfaceFronts fronts;
   OptimizerResult best{PoseParams::Zero(), -1e300};
   int winner = -1;
   bool guided_won = false;
@@ -459,6 +461,12 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     if (depth_energy_.weights().unseen_fingers != 0.0 && !input.pixel_labels.empty() && other_hand_ == nullptr) {
       unseen = unseen_fingers(input, *previous_);
       frame.unseen = &unseen;
+    }
+    // Surfaces seen at a slant lie further in front of the model's Gaussians (surface_fronts.hpp).
+    if (depth_energy_.weights().slant_front > 1.0) {
+      previous_hand_.update(model(), *previous_);
+      fronts = surface_fronts(model(), previous_hand_, depth_energy_.weights().slant_front);
+      frame.fronts = &fronts;
     }
     const PoseParams velocity = before_previous_ ? PoseParams(*previous_ - *before_previous_) : PoseParams::Zero();
     std::normal_distribution<double> alpha(config_.extrapolation_mean, config_.extrapolation_sigma);

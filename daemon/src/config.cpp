@@ -245,6 +245,8 @@ const std::vector<Field>& fields() {
      "w_u, weight of E_unseen: fingers the part labels do not see on a hand facing the camera curl (ours, late fusion's tracking only; 0 = the paper's energy; docs/TRACKER.md)", true},
     {"tracker.energy.coverage_cap", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.coverage_cap; }}, 0, 100,
      "c, E_sim's coverage cap: an image Gaussian earns at most c times its own overlap, however many model parts cover it (ours, late fusion's tracking only, not its (re)starts; 0 = the paper's E_sim; docs/TRACKER.md)", true},
+    {"tracker.energy.slant_front", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.slant_front; }}, 1, 10,
+     "k_max: a model part seen at a slant has the surface the camera sees up to k_max sigma_h in front of its Gaussians, the palm as a slab and each finger bone that points away from the camera as a capsule (ours, late fusion's tracking only; 1 = the paper's E_sim; docs/TRACKER.md)", true},
     {"tracker.energy.label_radius_mm", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.label_radius_mm; }}, 1, 5000,
      "R_i, radius of influence of the label similarity factor (Sec. 4.3: 200 mm)", true},
     {"tracker.energy.smoothness_translation_per_mm", DoubleRef{[](DaemonConfig& c) -> double& { return c.tracker.weights.smoothness_translation_per_mm; }}, 0, 1,

@@ -206,6 +206,20 @@ TEST_P(EnergyGradient, EveryTermMatchesFiniteDifferences) {
       [&](const PoseParams& p, PoseGradient* g) { return total_unseen.evaluate(unseen_frame, p, hand, g); }, pose,
       "E with E_unseen");
 
+  // E_sim with the surface fronts of the previous pose (surface_fronts.hpp), capped as late fusion
+  // tracks: d_p moves with k_p, which holds for the frame, so the gradient keeps eq. 7's form.
+  hand.update(model, prev);
+  const SurfaceFronts fronts = surface_fronts(model, hand, 3.0);
+  EnergyFrame fronts_frame = frame;
+  fronts_frame.fronts = &fronts;
+  hand.update(model, pose);
+  EXPECT_NE(capped_sim.evaluate_centres(model, hand, input, nullptr, &fronts),
+            capped_sim.evaluate_centres(model, hand, input, nullptr))
+      << "the fronts must move some model Gaussian for a real check";
+  expect_gradient_matches(
+      [&](const PoseParams& p, PoseGradient* g) { return total.evaluate(fronts_frame, p, hand, g); }, pose,
+      "E with surface fronts");
+
   // E_hand against another hand overlapping this one: beside it (a second right hand), and a left
   // hand (mirrored) reaching into it from the thumb side; its pose is one more random pose.
   const InterHandCollisionTerm inter;
@@ -246,6 +260,48 @@ TEST(EnergyTerms, SimilarityPeaksWhenModelSitsOnItsOwnImage) {
     moved.head<3>() += shift;
     hand.update(model, moved);
     EXPECT_LT(sim.evaluate(model, hand, input, nullptr), at_truth) << "shift " << shift.transpose();
+  }
+}
+
+// k_p (surface_fronts.hpp): 1 for a hand seen square on; a palm tipped 60 deg from the view has
+// its surface 1 / cos 60 = 2 sigma_h in front, capped at k_max; a finger bone pointing away from
+// the camera likewise, one pointing toward it stays at 1.
+TEST(EnergyTerms, SurfaceFrontsMoveForwardWhereTheHandIsSeenAtASlant) {
+  const HandModel model = HandModel::default_adult();
+  const auto fronts_at = [&](double tip_rad, PosedHand& hand) {
+    PoseParams pose = PoseParams::Zero();
+    pose.head<3>() << 0, 0, 400;
+    pose[3] = tip_rad;  // about the camera's x axis: the fingers toward (+) or away from (-) it
+    hand.update(model, pose);
+    return surface_fronts(model, hand, kMeasuredSlantFront);
+  };
+  const auto& gaussians = model.gaussians();
+  PosedHand hand;
+  // Square on: the rays through the Gaussians are at most ~25 deg off the camera's axis (the
+  // fingertips, 180 mm above it at 400 mm), so a part lying across the view is seen at most that
+  // slanted: 1 / cos 25 deg = 1.10.
+  const SurfaceFronts square = fronts_at(0.0, hand);
+  for (int i = 0; i < hand.gaussian_count(); ++i) {
+    EXPECT_LT(square.sigmas[static_cast<size_t>(i)], 1.11) << "Gaussian " << i;
+    EXPECT_GE(square.sigmas[static_cast<size_t>(i)], 1.0) << "Gaussian " << i;
+  }
+  for (const double tip_rad : {-std::numbers::pi / 3, std::numbers::pi / 3}) {
+    const SurfaceFronts tipped = fronts_at(tip_rad, hand);
+    const bool away = hand.fingertip(kMiddle).z() > hand.joints()[joint_index(kMiddle, 0)].z();
+    EXPECT_EQ(away, tip_rad < 0.0);
+    for (int i = 0; i < hand.gaussian_count(); ++i) {
+      const auto& g = gaussians[static_cast<size_t>(i)];
+      const double k = tipped.sigmas[static_cast<size_t>(i)];
+      if (g.bone == kPalmBone) {
+        EXPECT_DOUBLE_EQ(k, kMeasuredSlantFront) << "palm Gaussian " << i << " at " << tip_rad << " rad";
+      } else if (g.bone / kBonesPerFinger == kMiddle) {
+        if (away) {
+          EXPECT_DOUBLE_EQ(k, kMeasuredSlantFront) << "middle finger Gaussian " << i << ", pointing away";
+        } else {
+          EXPECT_EQ(k, 1.0) << "middle finger Gaussian " << i << ", pointing toward the camera";
+        }
+      }
+    }
   }
 }
 

@@ -329,14 +329,15 @@ TEST(HandednessRetrial, AHandTakenForTheWrongHandOnAFistIsTriedAgain) {
                                    "again: this scene no longer tests them";
 }
 
-// A flat hand seen from the back (adbadd in the back view, subject 3, as in scripts/eval-synthetic):
+// A flat hand seen from the back (adbadd in the back view, subject 7, as in scripts/eval-synthetic):
 // its right-hand fit and the left hand's mirror image with the palm toward the camera explain the
 // depth alike, and its first trial's evidence is a tie. What the depth leaves open, the camera's
 // arrangement decides (TrackerConfig::arrangement, Tracker::weigh): a camera facing the user
 // expects the palm, and reports this hand as a left hand throughout; a head-mounted camera expects
-// the back, and reports the right hand.
+// the back, and reports the right hand. (Subject 3 was this scene until the surface fronts,
+// 2026-11-29, which tell its side in 19 % of the frames; of subjects 1-9 only 7 is still a tie.)
 TEST(HandednessTie, AFlatHandShowsTheSideItsCamerasArrangementExpects) {
-  const synth::SynthOptions options = benchmark_sequence("adbadd", synth::View::kBack, 3);
+  const synth::SynthOptions options = benchmark_sequence("adbadd", synth::View::kBack, 7);
   const auto share_right = [&](CameraArrangement arrangement) {
     TrackerConfig config;
     config.arrangement = arrangement;

@@ -230,6 +230,9 @@ int main(int argc, char** argv) {
   app.add_option("--coverage-cap", config.weights.coverage_cap,
                  "late fusion: c, E_sim's coverage cap while tracking (default 2, measured best; 0: the paper's E_sim; docs/TRACKER.md, \"E_sim's coverage cap\")")
       ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--slant-front", config.weights.slant_front,
+                 "late fusion: k_max, how many sigma_h in front of a model Gaussian seen at a slant the surface may lie while tracking (default 1.5, measured best; 1: the paper's E_sim; docs/TRACKER.md, \"Surfaces seen at a slant\")")
+      ->check(CLI::Range(1.0, 10.0));
   app.add_option("--w-unseen", config.weights.unseen_fingers,
                  "late fusion: w_u, weight of E_unseen while tracking (default 0.01, measured best; 0: the paper's energy; docs/TRACKER.md, \"Unseen fingers curl\")")
       ->check(CLI::Range(0.0, 100.0));

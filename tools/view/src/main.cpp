@@ -50,7 +50,7 @@ struct Args {
   std::string out;
   std::optional<int> iterations, init_iterations, particles;
   int max_hands = handtrack::TrackerConfig{}.max_hands;  // handtrackd's default (tracker.max_hands)
-  std::optional<double> near_mm, far_mm;
+  std::optional<double> near_mm, far_mm, slant_front;
   bool crop = false;
   int panel_height = 0;
   std::string energy = "late-fusion";
@@ -64,6 +64,7 @@ handtrack::TrackerConfig tracker_config(const Args& a) {
   if (a.iterations) config.optimizer.iterations = *a.iterations;
   if (a.init_iterations) config.init_iterations = *a.init_iterations;
   if (a.particles) config.particles = *a.particles;
+  if (a.slant_front) config.weights.slant_front = *a.slant_front;
   if (a.near_mm) config.input.near_mm = *a.near_mm;
   if (a.far_mm) config.input.far_mm = *a.far_mm;
   if (config.input.far_mm <= config.input.near_mm) throw UsageError("--far-mm must be greater than --near-mm");
@@ -271,6 +272,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 10000.0));
   app.add_option("--energy", a.energy, "late-fusion (default, with the shipped forest) or depth-only")
       ->check(CLI::IsMember({"late-fusion", "depth-only"}));
+  app.add_option("--slant-front", a.slant_front,
+                 "k_max of the surface fronts while late fusion tracks (default 1.5; 1: the paper's E_sim), as "
+                 "handtrackd's tracker.energy.slant_front")
+      ->check(CLI::Range(1.0, 10.0));
   app.add_option("--arrangement", a.arrangement,
                  "facing (default: a camera facing the user) or head-mounted (at the user's eyes), as handtrackd's "
                  "tracker.arrangement")

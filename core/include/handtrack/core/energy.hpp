@@ -17,6 +17,7 @@
 #include "handtrack/core/hand_model.hpp"
 #include "handtrack/core/kinematics.hpp"
 #include "handtrack/core/pose.hpp"
+#include "handtrack/core/surface_fronts.hpp"
 #include "handtrack/core/unseen_fingers.hpp"
 
 #include <vector>
@@ -77,6 +78,10 @@ struct EnergyWeights {
   // PoseTracker uses it for tracking with late fusion only: the (re)start search and its checks
   // keep eq. 6 (search_weights, tracker.hpp).
   double coverage_cap = kMeasuredCoverageCap;
+  // k_max of the surface fronts (surface_fronts.hpp; ours): model Gaussians seen at a slant have
+  // the surface the camera sees up to k_max sigma_h in front of them. 1: eq. 7's d_p = z - sigma_h.
+  // PoseTracker uses it while late fusion tracks (the fronts come from the previous pose).
+  double slant_front = kMeasuredSlantFront;
   // R_i, Sec. 4.3: radius of influence of the label similarity factor.
   double label_radius_mm = 200.0;
   // E_smo mixes units; the paper's w_s = 1 balances it in SI units (metres and radians), so
@@ -101,7 +106,8 @@ enum class SimilarityFactor {
 // D_qq = pi sigma_q^2 (q's overlap with itself): the pairs of a q over its cap add nothing to the
 // gradient either.
 // with the projected model Gaussian (Sec. 3.2, scaled orthographic):
-//   mu_p = K [I|0] mu_h,  sigma_p = sigma_h f / z,  d_p = z - sigma_h
+//   mu_p = K [I|0] mu_h,  sigma_p = sigma_h f / z,  d_p = z - k_p sigma_h
+// k_p = 1 (the paper), or a frame's SurfaceFronts (surface_fronts.hpp; constant in the pose)
 // and the 2D overlap D_pq = 2 pi sigma_p^2 sigma_q^2 / S exp(-|mu_p - mu_q|^2 / 2S),
 // S = sigma_p^2 + sigma_q^2. Gradient per model Gaussian:
 //   dD/dmu_p = -D (mu_p - mu_q) / S
@@ -120,9 +126,10 @@ class SimilarityTerm {
   SimilarityTerm(SimilarityFactor factor, double label_radius_mm, double coverage_cap = 0.0)
       : factor_(factor), label_radius_mm_(label_radius_mm), coverage_cap_(coverage_cap) {}
   double evaluate(const HandModel& model, const PosedHand& hand, const DepthInput& input, PoseGradient* gradient) const;
-  // E_sim, adding dE_sim/d centre of each model Gaussian into *dE_dcentres when not null.
+  // E_sim, adding dE_sim/d centre of each model Gaussian into *dE_dcentres when not null; with
+  // `fronts`, d_p = z - k_p sigma_h (k_p = fronts->sigmas), else z - sigma_h.
   double evaluate_centres(const HandModel& model, const PosedHand& hand, const DepthInput& input,
-                          CentreGradients* dE_dcentres) const;
+                          CentreGradients* dE_dcentres, const SurfaceFronts* fronts = nullptr) const;
 
  private:
   SimilarityFactor factor_;
@@ -251,6 +258,7 @@ struct EnergyFrame {
   const PoseParams* before_previous = nullptr;  // Theta^{t-2}
   const HandObstacle* other_hand = nullptr;     // E_hand is off when null
   const UnseenFingers* unseen = nullptr;        // E_unseen is off when null
+  const SurfaceFronts* fronts = nullptr;        // E_sim's d_p = z - sigma_h when null (eq. 7)
 };
 
 class PoseEnergy {
