@@ -22,7 +22,7 @@
 // where cos is |n . r| for the palm's Gaussians and sqrt(1 - (a . r)^2) for a finger bone's. A bone
 // counts only where it points away from the camera (a . r > 0): then the ray from its centre
 // toward the camera runs back along the finger toward the palm, which is there; pointing toward
-// the camera it runs out through the fingertip (with every bone: 0.6 mm worse in the palm view,
+// the camera it runs out through the fingertip (with every bone: 0.7 mm worse in the palm view,
 // the flexed fingers of pinch and tigergrasp). k_max keeps a surface seen edge-on from moving the
 // front without bound (a palm edge-on is seen at its edge, one sigma_h in front).
 //
