@@ -215,6 +215,24 @@ TEST_F(ViewCli, EveryKthFrameOfASequence) {
   EXPECT_FALSE(fs::exists(dir_ / "out_000001.png"));
 }
 
+// --hand fixes the hand fitted, as handtrackd's tracker.handedness does: a right hand fitted as
+// the left one is another pose, so the two pictures differ (with --hand ignored, both would be
+// auto's, the same to the pixel: tracking is deterministic).
+TEST_F(ViewCli, HandChoosesTheHandFitted) {
+  const fs::path seq = make_sequence(6);
+  const auto render = [&](const std::string& hand) {
+    const fs::path out = dir_ / (hand + ".png");
+    const ProcessResult r = view("--seq '" + seq.string() + "' --frame 5 --hand " + hand + " --out '" + out.string() + "'");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return read_png_rgb(out);
+  };
+  const auto right = render("right");
+  const auto left = render("left");
+  ASSERT_TRUE(right && left);
+  ASSERT_EQ(right->pixels.size(), left->pixels.size());
+  EXPECT_NE(right->pixels, left->pixels);
+}
+
 TEST_F(ViewCli, RendersASingleDepthPng) {
   const fs::path depth = write_hand_png();
   const fs::path out = dir_ / "single.png";
@@ -286,7 +304,7 @@ TEST_F(ViewCli, FrameOutOfRangeFailsCleanly) {
 
 TEST_F(ViewCli, UsageErrorsAreOneLine) {
   for (const std::string args : {"", "--out x.png", "--seq a --depth b --out x.png", "--frame -3 --out x.png",
-                                 "--bogus", "--arrangement sideways --out x.png"}) {
+                                 "--bogus", "--arrangement sideways --out x.png", "--hand both --out x.png"}) {
     const ProcessResult r = view(args);
     EXPECT_NE(r.exit_code, 0) << args;
     EXPECT_NE(r.exit_code, 1) << args << ": usage errors are not input errors";

@@ -55,6 +55,7 @@ struct Args {
   int panel_height = 0;
   std::string energy = "late-fusion";
   std::string arrangement = "facing";
+  std::string hand = "auto";
   std::string forest;
 };
 
@@ -70,6 +71,7 @@ handtrack::TrackerConfig tracker_config(const Args& a) {
   if (config.input.far_mm <= config.input.near_mm) throw UsageError("--far-mm must be greater than --near-mm");
   if (a.energy == "late-fusion") config.mode = handtrack::EnergyMode::kLateFusion;
   handtrack::parse_camera_arrangement(a.arrangement, &config.arrangement);  // one of the names CLI11 checked
+  handtrack::parse_handedness_mode(a.hand, &config.handedness);           // likewise
   return config;
 }
 
@@ -280,6 +282,10 @@ int main(int argc, char** argv) {
                  "facing (default: a camera facing the user) or head-mounted (at the user's eyes), as handtrackd's "
                  "tracker.arrangement")
       ->check(CLI::IsMember({"facing", "head-mounted"}));
+  app.add_option("--hand", a.hand,
+                 "auto (default: both hands, the better fit chosen at every (re)start), right or left, as handtrackd's "
+                 "tracker.handedness")
+      ->check(CLI::IsMember({"right", "left", "auto"}));
   app.add_option("--forest", a.forest,
                  "part-classification forest for late fusion (default: the shipped one, $HANDTRACK_FOREST, data/ or "
                  "/usr/share/handtrack)")
