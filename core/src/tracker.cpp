@@ -456,15 +456,19 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     frame.previous = &*previous_;
     frame.before_previous = before_previous_ ? &*before_previous_ : nullptr;
     // Fingers the labels do not see on a hand facing the camera curl (unseen_fingers.hpp): weighed
-    // once a frame, from its labels and the previous pose. Not beside another hand, which can hide
-    // an outstretched finger as well (two_cross's left hand behind the right: 9.9 -> 21.6 mm).
-    if (depth_energy_.weights().unseen_fingers != 0.0 && !input.pixel_labels.empty() && other_hand_ == nullptr) {
-      unseen = unseen_fingers(input, *previous_);
+    // once a frame, from its labels, the segmented hand and the previous pose. Not beside another
+    // hand, which can hide an outstretched finger as well (two_cross's left hand behind the right:
+    // 9.9 -> 21.6 mm).
+    const bool weigh_unseen =
+        depth_energy_.weights().unseen_fingers != 0.0 && !input.pixel_labels.empty() && other_hand_ == nullptr;
+    const bool slanted = depth_energy_.weights().slant_front > 1.0;
+    if (weigh_unseen || slanted) previous_hand_.update(model(), *previous_);
+    if (weigh_unseen) {
+      unseen = unseen_fingers(input, *previous_, previous_hand_);
       frame.unseen = &unseen;
     }
     // Surfaces seen at a slant lie further in front of the model's Gaussians (surface_fronts.hpp).
-    if (depth_energy_.weights().slant_front > 1.0) {
-      previous_hand_.update(model(), *previous_);
+    if (slanted) {
       fronts = surface_fronts(model(), previous_hand_, depth_energy_.weights().slant_front);
       frame.fronts = &fronts;
     }

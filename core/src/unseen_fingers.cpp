@@ -1,7 +1,5 @@
 #include "handtrack/core/unseen_fingers.hpp"
 
-#include "handtrack/core/kinematics.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -9,7 +7,58 @@
 
 namespace handtrack {
 
-UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous) {
+namespace {
+
+// c_f of unseen_fingers.hpp for the fingers index..little (0 for the thumb): how much each finger
+// is curled as in a fist, by how far the segmented hand reaches beyond its knuckle.
+std::array<double, kNumFingers> fist_curl(const DepthInput& input, const PosedHand& hand) {
+  std::array<double, kNumFingers> curl{};
+  const CameraIntrinsics& cam = input.camera;
+  const auto pixels = static_cast<size_t>(cam.width) * static_cast<size_t>(cam.height);
+  if (pixels == 0 || input.hand_mask.size() != pixels || input.filtered_mm.size() != pixels) return curl;
+  // Each finger's knuckle, its direction in the palm plane (the proximal bone without its flexion,
+  // on the fingers' side; the hand's own axis where that is more than about 45 deg off it or the
+  // bone stands nearly square to the palm) and the direction across it.
+  const Eigen::Vector3d normal = hand.camera_R_hand().col(2);
+  const Eigen::Vector3d fingers = hand.camera_R_hand().col(1);
+  std::array<Eigen::Vector3d, kNumFingers> knuckle;
+  std::array<Eigen::Vector3d, kNumFingers> along;
+  std::array<Eigen::Vector3d, kNumFingers> across;
+  for (int f = kIndex; f < kNumFingers; ++f) {
+    const auto i = static_cast<size_t>(f);
+    knuckle[i] = hand.joints()[static_cast<size_t>(joint_index(f, 0))];
+    const Eigen::Vector3d bone = (hand.joints()[static_cast<size_t>(joint_index(f, 1))] - knuckle[i]).normalized();
+    Eigen::Vector3d in_plane = bone - normal * normal.dot(bone);
+    if (in_plane.dot(fingers) < 0.0) in_plane = -in_plane;
+    const bool usable = in_plane.norm() > 0.3 && in_plane.normalized().dot(fingers) > 0.7;
+    along[i] = usable ? Eigen::Vector3d(in_plane.normalized()) : fingers;
+    across[i] = normal.cross(along[i]).normalized();
+  }
+  // Over the segmented hand's pixels within kReachBandMm across each finger's line, the farthest
+  // along it.
+  std::array<double, kNumFingers> reach{};
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      const size_t p = static_cast<size_t>(v) * static_cast<size_t>(cam.width) + static_cast<size_t>(u);
+      if (input.hand_mask[p] == 0 || input.filtered_mm[p] <= 0.0F) continue;
+      const Eigen::Vector3d point = cam.unproject(u, v, input.filtered_mm[p]);
+      for (int f = kIndex; f < kNumFingers; ++f) {
+        const auto i = static_cast<size_t>(f);
+        const Eigen::Vector3d q = point - knuckle[i];
+        if (std::abs(q.dot(across[i])) <= kReachBandMm) reach[i] = std::max(reach[i], q.dot(along[i]));
+      }
+    }
+  }
+  for (int f = kIndex; f < kNumFingers; ++f) {
+    const auto i = static_cast<size_t>(f);
+    curl[i] = std::clamp((kOpenReachMm - reach[i]) / (kOpenReachMm - kCurledReachMm), 0.0, 1.0);
+  }
+  return curl;
+}
+
+}  // namespace
+
+UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous, const PosedHand& previous_hand) {
   UnseenFingers unseen;
   // Per label value, over the image: the labels are 0 off the hand (most of the image), so eight
   // at a time are skipped while they are all 0.
@@ -36,10 +85,17 @@ UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous
   const double facing = r.col(2).z() * r.col(2).z();
   const double across_view = facing * (1.0 - std::abs(r.col(1).z()));
   const double from_behind = std::max(0.0, r.col(2).z()) * std::max(0.0, r.col(1).z());
+  // Seen from behind, a fist's fingers go toward the relaxed fist instead of the half curl.
+  std::array<double, kNumFingers> curl{};
+  if (from_behind > 0.0) curl = fist_curl(input, previous_hand);
+  double fist = 0.0;
+  for (int f = kIndex; f < kNumFingers; ++f) fist += curl[static_cast<size_t>(f)] / 4.0;
   for (int f = kIndex; f < kNumFingers; ++f) {
-    const double share = static_cast<double>(seen[static_cast<size_t>(f)]) / labelled;
-    unseen.weight[static_cast<size_t>(f)] = across_view * (1.0 - std::min(1.0, share / kSeenFingerShare));
-    unseen.held[static_cast<size_t>(f)] = from_behind;
+    const auto k = static_cast<size_t>(f);
+    const double share = static_cast<double>(seen[k]) / labelled;
+    const double curled = curl[k] * fist;
+    unseen.weight[k] = across_view * (1.0 - std::min(1.0, share / kSeenFingerShare)) + from_behind * curled;
+    unseen.held[k] = from_behind * (1.0 - curled);
   }
   return unseen;
 }

@@ -319,11 +319,13 @@ TEST(EnergyTerms, UnseenFingersAreTheFingersTheLabelsMissOnAHandFacingTheCamera)
   label(part_label(kMiddle, 2), 80);
   label(part_label(kLittle, 1), 20);  // 2 % of the labelled pixels: half seen
   label(kBackground, 500);            // not counted
-  // u_f and h_f for a previous pose turned by `rotation`.
+  // u_f and h_f for a previous pose turned by `rotation` (no segmented hand: no reach beyond the
+  // knuckles, which FistsFromBehind in test_views.cpp tests on rendered frames).
+  const HandModel model = HandModel::default_adult();
   const auto fingers = [&](const Eigen::Vector3d& rotation) {
     PoseParams pose = PoseParams::Zero();
     pose.segment<3>(kRotationParam) = rotation;
-    return unseen_fingers(input, pose);
+    return unseen_fingers(input, pose, PosedHand(model, pose));
   };
   const auto weights = [&](const Eigen::Vector3d& rotation) { return fingers(rotation).weight; };
   const auto held = [&](const Eigen::Vector3d& rotation) { return fingers(rotation).held; };

@@ -285,7 +285,7 @@ class PoseTracker {
   PoseEnergy guided_energy_;
   AdaptiveGradientAscent optimizer_;
   PosedHand scratch_;
-  PosedHand previous_hand_;  // the previous pose, posed for its surface fronts
+  PosedHand previous_hand_;  // the previous pose, posed for its surface fronts and the unseen fingers
   std::unique_ptr<BackgroundSearch> background_;  // TrackerConfig::background_checks
   const HandObstacle* other_hand_ = nullptr;
   std::mt19937_64 rng_;

@@ -40,9 +40,30 @@
 // across the view). theta^half = 0.6 rad and the weight were chosen on ten head-mounted sequences
 // of seeds 1-2 and measured on the whole benchmark of seeds 1-9 (docs/TRACKER.md, "Fingers seen
 // from behind hold a half curl").
+//
+// Unless the hand is a fist: from behind, fingers held at the half curl that are really curled
+// into the palm put their tips 60-77 mm off (head-mounted flexex1, fitted at 45-75 deg of curl
+// where the truth closes to 125-140). What tells them apart is the depth beyond the
+// knuckles: an extended or half-curled finger seen from behind goes on past its knuckle, a finger
+// curled into the palm does not. So per finger, from the previous pose posed:
+//
+//   r_f = the farthest a segmented hand pixel reaches beyond the finger's knuckle (MCP) along its
+//         direction in the palm plane (the proximal bone with the flexion taken out), within
+//         kReachBandMm across it;
+//   c_f = clamp((kOpenReachMm - r_f) / (kOpenReachMm - kCurledReachMm), 0, 1),   c = mean_f c_f,
+//   k_f = c_f c,   h_f -> h_f (1 - k_f),   u_f += h_f k_f   (toward the relaxed fist).
+//
+// The product with the mean: one curled finger beside extended ones (a pinch's index, which curls
+// to 80 deg, not to a fist) is not pulled as far as the fingers of a fist; a fist's are, together.
+// Set on the 42 head-mounted sequences of seeds 1-3 (29.22 -> 27.17 mm; c_f alone 27.34, with
+// the pinch 20.6 -> 27.0 mm), then measured on seeds 4-6 and 7-9 (docs/TRACKER.md, "Fists seen
+// from behind"). A flying pixel on the hand's outline, between the hand and what lies behind it,
+// counts as reach; a fit whose knuckles are off reads the reach of whatever lies on its lines.
+// Guards against both were tried and did worse on the sets they were not chosen on.
 
 #include "handtrack/core/depth_input.hpp"
 #include "handtrack/core/hand_layout.hpp"
+#include "handtrack/core/kinematics.hpp"
 #include "handtrack/core/pose.hpp"
 
 #include <array>
@@ -57,6 +78,13 @@ inline constexpr double kSeenFingerShare = 0.04;
 // length are held.
 inline constexpr std::array<double, 3> kHalfCurlFlexion = {0.6, 0.6, 0.6};
 
+// A finger whose reach beyond its knuckle (r_f above) is kCurledReachMm or less is curled as in a
+// fist (c_f = 1); kOpenReachMm or more, it is not (c_f = 0). The reach is measured over the hand
+// pixels within kReachBandMm across the finger's line.
+inline constexpr double kCurledReachMm = 10.0;
+inline constexpr double kOpenReachMm = 35.0;
+inline constexpr double kReachBandMm = 10.0;
+
 // u_f and h_f of one frame (0 for the thumb).
 struct UnseenFingers {
   std::array<double, kNumFingers> weight{};  // u_f, toward the relaxed fist
@@ -64,8 +92,10 @@ struct UnseenFingers {
 };
 
 // u_f from the frame's part labels and the previous pose, h_f from the previous pose (only its
-// global rotation is read); all 0 without labels.
-UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous);
+// global rotation is read), each moved toward the fist by the segmented hand's reach beyond the
+// knuckles of `previous_hand` (the previous pose posed); all 0 without labels, and no reach
+// without a segmented hand (hand_mask not the image's size).
+UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous, const PosedHand& previous_hand);
 
 // E_unseen at `params`; adds dE_unseen/dTheta into *gradient when not null.
 double unseen_finger_energy(const UnseenFingers& unseen, const PoseParams& params, PoseGradient* gradient);
