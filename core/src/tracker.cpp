@@ -464,7 +464,7 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
     const bool slanted = depth_energy_.weights().slant_front > 1.0;
     if (weigh_unseen || slanted) previous_hand_.update(model(), *previous_);
     if (weigh_unseen) {
-      unseen = unseen_fingers(input, *previous_, previous_hand_);
+      unseen = unseen_fingers(input, previous_hand_);
       frame.unseen = &unseen;
     }
     // Surfaces seen at a slant lie further in front of the model's Gaussians (surface_fronts.hpp).

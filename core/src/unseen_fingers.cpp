@@ -58,7 +58,7 @@ std::array<double, kNumFingers> fist_curl(const DepthInput& input, const PosedHa
 
 }  // namespace
 
-UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous, const PosedHand& previous_hand) {
+UnseenFingers unseen_fingers(const DepthInput& input, const PosedHand& previous) {
   UnseenFingers unseen;
   // Per label value, over the image: the labels are 0 off the hand (most of the image), so eight
   // at a time are skipped while they are all 0.
@@ -81,13 +81,13 @@ UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous
   }
   if (labelled == 0) return unseen;
   // Columns of camera_R_hand: the hand's y axis runs along the fingers, its z axis out of the palm.
-  const Eigen::Matrix3d r = hand_rotation(previous);
+  const Eigen::Matrix3d& r = previous.camera_R_hand();
   const double facing = r.col(2).z() * r.col(2).z();
   const double across_view = facing * (1.0 - std::abs(r.col(1).z()));
   const double from_behind = std::max(0.0, r.col(2).z()) * std::max(0.0, r.col(1).z());
   // Seen from behind, a fist's fingers go toward the relaxed fist instead of the half curl.
   std::array<double, kNumFingers> curl{};
-  if (from_behind > 0.0) curl = fist_curl(input, previous_hand);
+  if (from_behind > 0.0) curl = fist_curl(input, previous);
   double fist = 0.0;
   for (int f = kIndex; f < kNumFingers; ++f) fist += curl[static_cast<size_t>(f)] / 4.0;
   for (int f = kIndex; f < kNumFingers; ++f) {

@@ -325,7 +325,7 @@ TEST(EnergyTerms, UnseenFingersAreTheFingersTheLabelsMissOnAHandFacingTheCamera)
   const auto fingers = [&](const Eigen::Vector3d& rotation) {
     PoseParams pose = PoseParams::Zero();
     pose.segment<3>(kRotationParam) = rotation;
-    return unseen_fingers(input, pose, PosedHand(model, pose));
+    return unseen_fingers(input, PosedHand(model, pose));
   };
   const auto weights = [&](const Eigen::Vector3d& rotation) { return fingers(rotation).weight; };
   const auto held = [&](const Eigen::Vector3d& rotation) { return fingers(rotation).held; };

@@ -237,7 +237,7 @@ TEST(FistsFromBehind, TheHandBeyondTheKnucklesTellsAFistFromAnOpenHand) {
     posed.override_pose(pose);
     const FixedLabels labels(&rendered.labels.pixels);
     const DepthInput& input = builder.build(rendered.depth, posed.hint(), &labels);
-    return unseen_fingers(input, pose, PosedHand(model, pose));
+    return unseen_fingers(input, PosedHand(model, pose));
   };
   // k_f, each finger's share of h_f that goes to the fist (h_f = held + that share).
   const auto to_fist = [](const UnseenFingers& u, int f) {

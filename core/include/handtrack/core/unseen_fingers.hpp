@@ -91,11 +91,11 @@ struct UnseenFingers {
   std::array<double, kNumFingers> held{};    // h_f, toward the half curl
 };
 
-// u_f from the frame's part labels and the previous pose, h_f from the previous pose (only its
-// global rotation is read), each moved toward the fist by the segmented hand's reach beyond the
-// knuckles of `previous_hand` (the previous pose posed); all 0 without labels, and no reach
-// without a segmented hand (hand_mask not the image's size).
-UnseenFingers unseen_fingers(const DepthInput& input, const PoseParams& previous, const PosedHand& previous_hand);
+// u_f from the frame's part labels and the previous pose, h_f from the previous pose's rotation,
+// each moved toward the fist by the segmented hand's reach beyond the previous pose's knuckles
+// (`previous`: that pose posed); all 0 without labels, and no reach without a segmented hand
+// (hand_mask not the image's size).
+UnseenFingers unseen_fingers(const DepthInput& input, const PosedHand& previous);
 
 // E_unseen at `params`; adds dE_unseen/dTheta into *gradient when not null.
 double unseen_finger_energy(const UnseenFingers& unseen, const PoseParams& params, PoseGradient* gradient);
