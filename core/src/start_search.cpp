@@ -141,17 +141,12 @@ HandPlace StartSearch::place(const DepthInput& input, SearchPurpose purpose) con
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
   Eigen::Matrix2d sum_sq = Eigen::Matrix2d::Zero();
   int pixels = 0;
-  const CameraIntrinsics& cam = input.camera;
-  for (int v = 0; v < cam.height; ++v) {
-    for (int u = 0; u < cam.width; ++u) {
-      const auto i = static_cast<size_t>(v) * static_cast<size_t>(cam.width) + static_cast<size_t>(u);
-      if (input.hand_mask[i] == 0 || input.filtered_mm[i] <= 0.0F) continue;
-      const Eigen::Vector2d p = cam.unproject(u, v, input.filtered_mm[i]).head<2>();
-      sum += p;
-      sum_sq += p * p.transpose();
-      ++pixels;
-    }
-  }
+  for_each_hand_point(input, [&](const Vector3d& point) {
+    const Eigen::Vector2d p = point.head<2>();
+    sum += p;
+    sum_sq += p * p.transpose();
+    ++pixels;
+  });
   double length_mm = 0.0;
   if (pixels > 0) {
     const Eigen::Vector2d mean = sum / pixels;

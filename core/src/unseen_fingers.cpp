@@ -13,8 +13,7 @@ namespace {
 // is curled as in a fist, by how far the segmented hand reaches beyond its knuckle.
 std::array<double, kNumFingers> fist_curl(const DepthInput& input, const PosedHand& hand) {
   std::array<double, kNumFingers> curl{};
-  const CameraIntrinsics& cam = input.camera;
-  const auto pixels = static_cast<size_t>(cam.width) * static_cast<size_t>(cam.height);
+  const auto pixels = static_cast<size_t>(input.camera.width) * static_cast<size_t>(input.camera.height);
   if (pixels == 0 || input.hand_mask.size() != pixels || input.filtered_mm.size() != pixels) return curl;
   // Each finger's knuckle, its direction in the palm plane (the proximal bone without its flexion,
   // on the fingers' side; the hand's own axis where that is more than about 45 deg off it or the
@@ -37,18 +36,13 @@ std::array<double, kNumFingers> fist_curl(const DepthInput& input, const PosedHa
   // Over the segmented hand's pixels within kReachBandMm across each finger's line, the farthest
   // along it.
   std::array<double, kNumFingers> reach{};
-  for (int v = 0; v < cam.height; ++v) {
-    for (int u = 0; u < cam.width; ++u) {
-      const size_t p = static_cast<size_t>(v) * static_cast<size_t>(cam.width) + static_cast<size_t>(u);
-      if (input.hand_mask[p] == 0 || input.filtered_mm[p] <= 0.0F) continue;
-      const Eigen::Vector3d point = cam.unproject(u, v, input.filtered_mm[p]);
-      for (int f = kIndex; f < kNumFingers; ++f) {
-        const auto i = static_cast<size_t>(f);
-        const Eigen::Vector3d q = point - knuckle[i];
-        if (std::abs(q.dot(across[i])) <= kReachBandMm) reach[i] = std::max(reach[i], q.dot(along[i]));
-      }
+  for_each_hand_point(input, [&](const Eigen::Vector3d& point) {
+    for (int f = kIndex; f < kNumFingers; ++f) {
+      const auto i = static_cast<size_t>(f);
+      const Eigen::Vector3d q = point - knuckle[i];
+      if (std::abs(q.dot(across[i])) <= kReachBandMm) reach[i] = std::max(reach[i], q.dot(along[i]));
     }
-  }
+  });
   for (int f = kIndex; f < kNumFingers; ++f) {
     const auto i = static_cast<size_t>(f);
     curl[i] = std::clamp((kOpenReachMm - reach[i]) / (kOpenReachMm - kCurledReachMm), 0.0, 1.0);

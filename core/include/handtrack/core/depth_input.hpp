@@ -88,6 +88,20 @@ struct DepthInput {
   [[nodiscard]] bool has_hand() const { return !gaussians.empty(); }
 };
 
+// Calls visit(point) with the camera-frame point (mm) of each segmented hand pixel that has a depth,
+// row by row. `input` must be built (hand_mask and filtered_mm of the image's size).
+template <typename Visit>
+void for_each_hand_point(const DepthInput& input, const Visit& visit) {
+  const CameraIntrinsics& cam = input.camera;
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      const size_t i = static_cast<size_t>(v) * static_cast<size_t>(cam.width) + static_cast<size_t>(u);
+      if (input.hand_mask[i] == 0 || input.filtered_mm[i] <= 0.0F) continue;
+      visit(cam.unproject(u, v, input.filtered_mm[i]));
+    }
+  }
+}
+
 // Room in `input` for an input of a width x height image as DepthInputBuilder builds it, so that
 // copying one into it (operator=) allocates nothing: a background search's copy (tracker.cpp).
 void reserve_input(DepthInput& input, int width, int height);
