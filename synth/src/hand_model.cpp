@@ -123,13 +123,14 @@ HandShape HandShape::for_subject(const SubjectScale& subject) {
   s.subject = subject;
   const Vector3d scale(subject.width, subject.length, subject.width);
   const auto scale_point = [&](const Vector3d& p) -> Vector3d { return p.cwiseProduct(scale); };
-  for (auto& f : s.fingers) {
+  for (size_t k = 0; k < s.fingers.size(); ++k) {
     // Joint positions scale as in the tracker's model: base x by width, y by length, z unscaled
     // (only the thumb's base has z != 0). The solid palm below also thickens with width.
+    FingerShape& f = s.fingers[k];
     f.base_mm.x() *= subject.width;
     f.base_mm.y() *= subject.length;
-    for (auto& l : f.bone_length_mm) l *= subject.length;
-    for (auto& r : f.radius_mm) r *= subject.width;
+    for (auto& l : f.bone_length_mm) l *= subject.length * subject.finger_length[k];
+    for (auto& r : f.radius_mm) r *= subject.width * subject.finger_girth;
   }
   for (auto* c : {&s.forearm}) {
     c->a = scale_point(c->a);
@@ -140,8 +141,8 @@ HandShape HandShape::for_subject(const SubjectScale& subject) {
   for (auto& c : s.palm) {
     c.a = scale_point(c.a);
     c.b = scale_point(c.b);
-    c.radius_a *= subject.width;
-    c.radius_b *= subject.width;
+    c.radius_a *= subject.width * subject.palm_thickness;
+    c.radius_b *= subject.width * subject.palm_thickness;
   }
   s.palm_centre_mm = scale_point(s.palm_centre_mm);
   return s;

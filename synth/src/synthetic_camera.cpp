@@ -19,7 +19,13 @@ using Eigen::Vector3d;
 constexpr uint64_t kSubjectStream = 0x5B1EC7;
 constexpr uint64_t kNoiseStream = 0x0015E;
 constexpr uint64_t kBodyStream = 0xB0D1;  // Background::kNearBody's build
+constexpr uint64_t kProportionStream = 0x960B0;
 constexpr double kSubjectSpread = 0.10;  // random subjects: scales within +-10 % (module brief)
+// Proportions::kVaried: each finger's length within +-6 % (about two standard deviations of a
+// finger's length relative to the hand's among adults), the fingers' girth and the palm's
+// thickness within +-15 %.
+constexpr double kFingerLengthSpread = 0.06;
+constexpr double kGirthSpread = 0.15;
 // Two-hand scenes draw both hands into one z-buffer with hand k's solids labelled
 // part_label | (k + 1) << kHandTagShift, so that each pixel says which hand it shows; the tag is
 // split off into SynthFrame::hand_index afterwards.
@@ -116,6 +122,17 @@ Background default_background(std::string_view motion, View view) {
   return seen_in(motion, view) == View::kHeadMounted ? Background::kTable : Background::kBody;
 }
 
+std::string_view proportions_name(Proportions proportions) {
+  return proportions == Proportions::kVaried ? "varied" : "mean";
+}
+
+std::optional<Proportions> parse_proportions(std::string_view name) {
+  for (Proportions p : {Proportions::kMean, Proportions::kVaried}) {
+    if (proportions_name(p) == name) return p;
+  }
+  return std::nullopt;
+}
+
 std::string_view handedness_name(Handedness hand) { return hand == Handedness::kLeft ? "left" : "right"; }
 
 std::optional<Handedness> parse_handedness(std::string_view name) {
@@ -208,10 +225,14 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   std::array<SubjectScale, kTwoHands> subjects;
   if (options.subject) {
     const auto ok = [](double s) { return std::isfinite(s) && s >= 0.5 && s <= 2.0; };
-    if (!ok(options.subject->length) || !ok(options.subject->width)) {
-      throw std::invalid_argument("subject scale must be within [0.5, 2], got " +
-                                  std::to_string(options.subject->length) + "," +
-                                  std::to_string(options.subject->width));
+    const SubjectScale& given = *options.subject;
+    if (!ok(given.length) || !ok(given.width)) {
+      throw std::invalid_argument("subject scale must be within [0.5, 2], got " + std::to_string(given.length) +
+                                  "," + std::to_string(given.width));
+    }
+    if (!std::all_of(given.finger_length.begin(), given.finger_length.end(), ok) || !ok(given.finger_girth) ||
+        !ok(given.palm_thickness)) {
+      throw std::invalid_argument("subject proportions (finger lengths, girth, palm thickness) must be within [0.5, 2]");
     }
     subjects.fill(*options.subject);
   } else {
@@ -220,6 +241,15 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
       Rng rng = Rng::stream(options.seed, kSubjectStream, k);
       subjects[k].length = rng.uniform(1.0 - kSubjectSpread, 1.0 + kSubjectSpread);
       subjects[k].width = rng.uniform(1.0 - kSubjectSpread, 1.0 + kSubjectSpread);
+    }
+    options.subject = subjects[0];
+  }
+  if (options.proportions == Proportions::kVaried) {
+    for (size_t k = 0; k < kTwoHands; ++k) {
+      Rng rng = Rng::stream(options.seed, kProportionStream, k);
+      for (double& l : subjects[k].finger_length) l = rng.uniform(1.0 - kFingerLengthSpread, 1.0 + kFingerLengthSpread);
+      subjects[k].finger_girth = rng.uniform(1.0 - kGirthSpread, 1.0 + kGirthSpread);
+      subjects[k].palm_thickness = rng.uniform(1.0 - kGirthSpread, 1.0 + kGirthSpread);
     }
     options.subject = subjects[0];
   }

@@ -121,6 +121,50 @@ TEST(SynthCamera, RandomSubjectsStayWithinTenPercentAndDependOnTheSeed) {
   EXPECT_GT(lengths.back() - lengths.front(), 0.05) << "subjects hardly vary with the seed";
 }
 
+// Proportions::kVaried: each hand's fingers get their own lengths and the fingers and palm their
+// own thickness, drawn from the seed within the documented spreads; the size and the motion's
+// timing stay the seed's, and the motions still do what they say with the new fingers (the pinch
+// closes on its tips).
+TEST(SynthCamera, VariedProportionsGiveEachFingerItsOwnLengthAndKeepTheSize) {
+  const HandShape mean = HandShape::mean_adult();
+  std::vector<double> index_lengths;
+  for (uint64_t seed = 1; seed <= 20; ++seed) {
+    SynthOptions o = clean_options("pinch");
+    o.seed = seed;
+    const SyntheticCamera as_mean(o);
+    o.proportions = Proportions::kVaried;
+    const SyntheticCamera varied(o);
+    const SubjectScale& s = varied.subject();
+    EXPECT_EQ(s.length, as_mean.subject().length) << "seed " << seed;
+    EXPECT_EQ(s.width, as_mean.subject().width);
+    for (size_t f = 0; f < kNumFingers; ++f) {
+      EXPECT_GE(s.finger_length[f], 0.94);
+      EXPECT_LE(s.finger_length[f], 1.06);
+      EXPECT_NEAR(varied.shape().fingers[f].bone_length_mm[0],
+                  mean.fingers[f].bone_length_mm[0] * s.length * s.finger_length[f], 1e-9);
+      EXPECT_NEAR(varied.shape().fingers[f].radius_mm[0], mean.fingers[f].radius_mm[0] * s.width * s.finger_girth,
+                  1e-9);
+    }
+    index_lengths.push_back(s.finger_length[handtrack::kIndex]);
+    for (double t : {s.finger_girth, s.palm_thickness}) {
+      EXPECT_GE(t, 0.85);
+      EXPECT_LE(t, 1.15);
+    }
+    double closest = 1e9;
+    for (int i = 0; i < 300; i += 2) {
+      const Joints j = camera_frame_joints(varied.shape(), varied.pose(i));
+      closest = std::min(closest, (j[static_cast<size_t>(handtrack::fingertip_joint(handtrack::kThumb))] -
+                                   j[static_cast<size_t>(handtrack::fingertip_joint(handtrack::kIndex))])
+                                      .norm());
+    }
+    const double contact = varied.shape().fingers[handtrack::kThumb].radius_mm[3] +
+                           varied.shape().fingers[handtrack::kIndex].radius_mm[3];
+    EXPECT_NEAR(closest, contact, 2.0) << "seed " << seed << ": the pinch misses with these fingers";
+  }
+  std::sort(index_lengths.begin(), index_lengths.end());
+  EXPECT_GT(index_lengths.back() - index_lengths.front(), 0.06) << "the index's length hardly varies with the seed";
+}
+
 TEST(SynthCamera, SameSeedSameFramesDifferentSeedDifferentNoise) {
   SynthOptions o = clean_options("random");
   o.noise = true;
@@ -447,6 +491,12 @@ TEST(SynthCamera, RejectsBadOptions) {
   EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
   o = SynthOptions{};
   o.subject = SubjectScale{3.0, 1.0};
+  EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
+  o.subject = SubjectScale{};
+  o.subject->finger_length[handtrack::kRing] = 0.2;
+  EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
+  o.subject = SubjectScale{};
+  o.subject->palm_thickness = std::nan("");
   EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
 }
 

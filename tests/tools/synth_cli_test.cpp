@@ -162,6 +162,26 @@ TEST_F(SynthCli, Writes640x480SequenceWithConsistentGroundTruth) {
   EXPECT_EQ(handtrack::SequenceReader(seq).frame_count(), 3u);
 }
 
+// --proportions varied: subject.json says so and gives each hand's proportions, which its bone
+// lengths follow; the size stays the seed's. Anything but mean or varied is one clear error.
+TEST_F(SynthCli, VariedProportionsAreDrawnFromTheSeedAndWrittenDown) {
+  const fs::path mean = dir_ / "mean", varied = dir_ / "varied";
+  const std::string args = "--motion adbadd --frames 2 --seed 4 --no-noise --background none ";
+  ASSERT_EQ(run(args + "--out '" + mean.string() + "'").exit_code, 0);
+  const RunResult r = run(args + "--proportions varied --out '" + varied.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto m = nlohmann::json::parse(slurp(mean / "subject.json"));
+  const auto v = nlohmann::json::parse(slurp(varied / "subject.json"));
+  EXPECT_EQ(m.at("proportions"), "mean");
+  EXPECT_EQ(v.at("proportions"), "varied");
+  EXPECT_EQ(v.at("length_scale"), m.at("length_scale"));
+  const double ring = v.at("finger_length_scales").at(3).get<double>();
+  EXPECT_NE(ring, 1.0);
+  EXPECT_NEAR(v.at("fingers").at("ring").at("bone_lengths_mm")[0].get<double>(),
+              m.at("fingers").at("ring").at("bone_lengths_mm")[0].get<double>() * ring, 1e-9);
+  expect_one_line_error(args + "--proportions thin --out '" + (dir_ / "x").string() + "'", "--proportions");
+}
+
 // A two-hand motion writes both hands (docs/SEQUENCES.md): hand.json names them, each CSV row holds
 // hand 0's block then hand 1's (h1_...), and each hand's tips are its joints' tips. --hand and
 // --view, which it has no use for, are refused.

@@ -75,6 +75,16 @@ nlohmann::json fingers_json(const handtrack::synth::HandShape& shape) {
   return bones;
 }
 
+// One hand's scales: its size and its proportions (the fingers' own lengths and radii are in
+// "fingers").
+void add_scales(nlohmann::json& j, const handtrack::synth::SubjectScale& s) {
+  j["length_scale"] = s.length;
+  j["width_scale"] = s.width;
+  j["finger_length_scales"] = s.finger_length;
+  j["finger_girth_scale"] = s.finger_girth;
+  j["palm_thickness_scale"] = s.palm_thickness;
+}
+
 // The subject: one hand's scales and fingers at the top level; for a two-hand motion "hands", one
 // object per hand (its side, scales and fingers) in the order of the ground-truth blocks.
 void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticCamera& cam) {
@@ -87,11 +97,11 @@ void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticC
                       {"noise_sigma_k_per_mm", o.noise_params.sigma_k_per_mm},
                       {"background", std::string(handtrack::synth::background_name(o.background))},
                       {"ball_radius_mm", o.ball_radius_mm},
+                      {"proportions", std::string(handtrack::synth::proportions_name(o.proportions))},
                       {"pose_parameters", "poses.csv: frame, t_x,t_y,t_z (mm, wrist), r_x,r_y,r_z (axis-angle, "
                                           "R = exp(r) diag(1,-1,-1)), thumb..little abd,flex1,flex2,flex3 (rad)"}};
   if (cam.hand_count() == 1) {
-    j["length_scale"] = cam.subject().length;
-    j["width_scale"] = cam.subject().width;
+    add_scales(j, cam.subject());
     j["hand"] = std::string(handtrack::synth::handedness_name(o.hand));
     j["view"] = std::string(handtrack::synth::view_name(o.view));
     j["fingers"] = fingers_json(cam.shape());
@@ -102,10 +112,9 @@ void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticC
     j["view"] = std::string(handtrack::synth::view_name(handtrack::synth::two_hand_view(o.motion)));
     j["hands"] = nlohmann::json::array();
     for (int k = 0; k < cam.hand_count(); ++k) {
-      j["hands"].push_back({{"hand", k == 0 ? "right" : "left"},
-                            {"length_scale", cam.subject(k).length},
-                            {"width_scale", cam.subject(k).width},
-                            {"fingers", fingers_json(cam.shape(k))}});
+      nlohmann::json hand = {{"hand", k == 0 ? "right" : "left"}, {"fingers", fingers_json(cam.shape(k))}};
+      add_scales(hand, cam.subject(k));
+      j["hands"].push_back(std::move(hand));
     }
   }
   std::ofstream out(file);
@@ -198,6 +207,10 @@ int main(int argc, char** argv) {
   app.add_option("--seed", options.seed, "Seed for the subject (unless --subject-scale) and the noise");
   app.add_option("--subject-scale", subject, "Subject scales L,W (length, width; 1 = mean adult; default: drawn "
                                              "from the seed within +-10%)");
+  std::string proportions = "mean";
+  app.add_option("--proportions", proportions,
+                 "mean (default: the mean adult's, scaled by the subject's size) or varied (each hand's finger "
+                 "lengths, finger girth and palm thickness drawn from the seed as well)");
   app.add_flag("--noise,!--no-noise", options.noise, "Sensor noise model on (default) or off");
   app.add_option("--background", background,
                  "Background: body (default; head-mounted view and two_reach: table), table, desk (the hand rests on it), "
@@ -253,6 +266,8 @@ int main(int argc, char** argv) {
   if (!bg) return fail("--background must be body, table, desk, near-body or none, got '" + background + "'");
   const auto handedness = handtrack::synth::parse_handedness(hand);
   if (!handedness) return fail("--hand must be right or left, got '" + hand + "'");
+  const auto shape_proportions = handtrack::synth::parse_proportions(proportions);
+  if (!shape_proportions) return fail("--proportions must be mean or varied, got '" + proportions + "'");
 
   try {
     options.motion = motion;
@@ -260,6 +275,7 @@ int main(int argc, char** argv) {
     options.background = *bg;
     options.ball_radius_mm = ball_radius_mm;
     options.hand = *handedness;
+    options.proportions = *shape_proportions;
     options.view = *arrangement;
     options.camera = handtrack::synth::default_camera(width, height);
     if (!subject.empty()) options.subject = parse_subject(subject);

@@ -62,9 +62,16 @@ struct JointLimits {
 // A subject's size relative to the mean adult hand: `length` scales bone lengths and the hand
 // frame's y coordinates, `width` scales x coordinates and all radii. Finger bases keep their z (as
 // in the tracker's HandModel::default_adult); the palm and forearm solids scale z by `width`.
+// Proportions on top of the size (ours; the tracker's model scales by length, width and sigma only,
+// Sec. 6): each finger's bones by `finger_length[f]` (thumb..little), the fingers' radii by
+// `finger_girth` and the palm's solids' radii (its thickness) by `palm_thickness`. All 1: the mean
+// adult's proportions, which every subject had before (SynthOptions::proportions).
 struct SubjectScale {
   double length = 1.0;
   double width = 1.0;
+  std::array<double, kNumFingers> finger_length{1.0, 1.0, 1.0, 1.0, 1.0};
+  double finger_girth = 1.0;
+  double palm_thickness = 1.0;
 };
 
 struct FingerShape {
@@ -101,7 +108,8 @@ struct HandShape {
 
   // The mean adult right hand (scale 1.0) of the module brief.
   static HandShape mean_adult();
-  // mean_adult() scaled: lengths and y by subject.length, x, z and radii by subject.width.
+  // mean_adult() scaled: lengths and y by subject.length, x, z and radii by subject.width, then
+  // each finger's bones, the fingers' radii and the palm's radii by the subject's proportions.
   static HandShape for_subject(const SubjectScale& subject);
 };
 

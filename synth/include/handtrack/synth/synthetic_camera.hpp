@@ -54,6 +54,14 @@ enum class Handedness { kRight, kLeft };
 std::string_view handedness_name(Handedness hand);  // "right", "left"
 std::optional<Handedness> parse_handedness(std::string_view name);
 
+// Each hand's proportions beyond its size (SubjectScale): kMean, the mean adult's, which every
+// subject had before 2026-11-30; kVaried, drawn from the seed for each hand, whatever its size
+// (every finger's length +-6 % on its own, the fingers' girth and the palm's thickness +-15 %): the
+// hands of people, and of other renderers, differ in more than their length and width.
+enum class Proportions { kMean, kVaried };
+std::string_view proportions_name(Proportions proportions);  // "mean", "varied"
+std::optional<Proportions> parse_proportions(std::string_view name);
+
 // The SPEC.md camera (fx 224.502, fy 230.494 at 320x240, principal point at the image centre,
 // 60 fps, 1 mm depth units) with the focal lengths scaled to width x height.
 CameraIntrinsics default_camera(int width = 320, int height = 240);
@@ -67,6 +75,8 @@ struct SynthOptions {
   // nullopt: length and width scale drawn from the seed in [0.9, 1.1], for each hand of a two-hand
   // motion its own; given: every hand's.
   std::optional<SubjectScale> subject;
+  // kVaried: each hand's proportions drawn from the seed, replacing the subject's.
+  Proportions proportions = Proportions::kMean;
   bool noise = true;
   Background background = Background::kBody;
   CameraIntrinsics camera = default_camera();
