@@ -443,6 +443,27 @@ TEST(PartForestTraining, BodyImagesAreTheBodyWithoutTheHandAllBackground) {
   EXPECT_LT(hand_labelled, body_pixels / 100);     // at most the hand's edge flying into the body
 }
 
+TEST(PartForestTraining, VariedFractionVariesTheHandsAndNothingElse) {
+  // --varied-fraction: about that share of the images show a hand of varied proportions (synth
+  // --proportions varied), drawn from a stream of their own; the scenes are otherwise unchanged.
+  forest::SceneOptions half;
+  half.varied_fraction = 0.5;
+  const forest::SceneOptions none;
+  int varied = 0;
+  constexpr int kScenes = 200;
+  for (uint64_t i = 0; i < kScenes; ++i) {
+    const forest::Scene s = forest::make_scene(9, i, half);
+    const forest::Scene plain = forest::make_scene(9, i, none);
+    EXPECT_EQ(plain.options.proportions, synth::Proportions::kMean);
+    EXPECT_EQ(s.options.seed, plain.options.seed);
+    EXPECT_EQ(s.options.view, plain.options.view);
+    EXPECT_EQ(s.pose.translation_mm, plain.pose.translation_mm);
+    varied += s.options.proportions == synth::Proportions::kVaried ? 1 : 0;
+  }
+  EXPECT_GT(varied, kScenes * 35 / 100);
+  EXPECT_LT(varied, kScenes * 65 / 100);
+}
+
 TEST(SynthRenderPose, RenderingAMotionsPoseEqualsRenderingItsFrame) {
   synth::SynthOptions o;
   o.motion = "tigergrasp";

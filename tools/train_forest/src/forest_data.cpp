@@ -14,6 +14,7 @@ namespace handtrack::forest {
 namespace {
 
 constexpr uint64_t kSceneStream = 0xF0E57;  // Rng::stream purpose of the scene draws
+constexpr uint64_t kProportionsStream = 0x960B0;  // ... and of SceneOptions::varied_fraction's
 constexpr double kSubjectSpread = 0.10;      // subjects within +-10 % (as the synth's random subjects)
 constexpr int kTrainingSequenceFrames = 300;  // motion frames are drawn from 300-frame sequences
 constexpr int kHeldOutSequenceFrames = 241;   // held-out motions: other lengths, so other time samples
@@ -95,6 +96,10 @@ Scene make_scene(uint64_t seed, uint64_t index, const SceneOptions& options) {
       s.options.view != synth::View::kHeadMounted) {
     s.body = true;
     s.options.background = synth::Background::kNearBody;
+  }
+  if (options.varied_fraction > 0.0 &&
+      synth::Rng::stream(seed, index, kProportionsStream).uniform() < options.varied_fraction) {
+    s.options.proportions = synth::Proportions::kVaried;
   }
   return s;
 }
@@ -274,7 +279,7 @@ Confusion score_frame(const PartForest& forest, const DepthInput& input, const s
 }
 
 HeldOutResult evaluate_motions(const PartForest& forest, uint64_t seed_base, int frames_per_motion,
-                               synth::View view) {
+                               synth::View view, synth::Proportions proportions) {
   HeldOutResult result;
   DepthInputBuilder builder;
   synth::SynthFrame frame;
@@ -286,6 +291,7 @@ HeldOutResult evaluate_motions(const PartForest& forest, uint64_t seed_base, int
     o.seed = seed_base + m;
     o.background = kBackgrounds[m % kBackgrounds.size()];
     o.view = view;
+    o.proportions = proportions;
     synth::SyntheticCamera cam(o);
     for (int k = 0; k < frames_per_motion; ++k) {
       const int i = static_cast<int>((static_cast<int64_t>(k) * kHeldOutSequenceFrames + kHeldOutSequenceFrames / 2) /

@@ -56,6 +56,7 @@ std::string percent(double x) {
 struct EvalSummary {
   forest::HeldOutResult motions;
   std::array<forest::Confusion, synth::kViews.size()> views;  // the held-out motions in each view
+  std::array<forest::Confusion, synth::kViews.size()> varied_views;  // the same, hands of varied proportions
   forest::Confusion facing;  // held-out random poses, palm toward the camera (+- the SceneOptions ranges)
   forest::Confusion turned;  // held-out random poses turned any way (back, side, fingers toward / away)
   double ms_per_frame = 0.0;
@@ -66,8 +67,11 @@ EvalSummary evaluate(const PartForest& model, int frames_per_motion, int scenes)
   EvalSummary s;
   s.motions = forest::evaluate_motions(model, kHeldOutMotionSeed, frames_per_motion);
   s.views[0] = s.motions.overall;
-  for (size_t v = 1; v < synth::kViews.size(); ++v) {
-    s.views[v] = forest::evaluate_motions(model, kHeldOutMotionSeed, frames_per_motion, synth::kViews[v]).overall;
+  for (size_t v = 0; v < synth::kViews.size(); ++v) {
+    if (v > 0) s.views[v] = forest::evaluate_motions(model, kHeldOutMotionSeed, frames_per_motion, synth::kViews[v]).overall;
+    s.varied_views[v] = forest::evaluate_motions(model, kHeldOutMotionSeed, frames_per_motion, synth::kViews[v],
+                                                 synth::Proportions::kVaried)
+                            .overall;
   }
   forest::SceneOptions facing;
   facing.turned_fraction = 0.0;
@@ -113,7 +117,8 @@ void print_evaluation(std::ostream& out, const PartForest& model, const EvalSumm
   out << "held-out motions per view:\n";
   for (size_t v = 0; v < synth::kViews.size(); ++v) {
     out << "  " << synth::view_name(synth::kViews[v]) << ": " << percent(s.views[v].accuracy()) << " (hand parts only "
-        << percent(s.views[v].part_accuracy()) << ")\n";
+        << percent(s.views[v].part_accuracy()) << "); hands of varied proportions " << percent(s.varied_views[v].accuracy())
+        << "\n";
   }
   for (const auto& [name, c] : {std::pair{"palm toward the camera", &s.facing}, std::pair{"turned any way", &s.turned}}) {
     out << "held-out random poses, " << name << " (" << c->total() << " hand pixels): accuracy "
@@ -230,6 +235,10 @@ int main(int argc, char** argv) {
                  "Share of images of the body inside the working volume without the hand (a head, the rest of a "
                  "torso: what a free hand slot would be given), all background")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--varied-fraction", scene.varied_fraction,
+                 "Share of images whose hand has varied proportions (finger lengths, girth, palm thickness: "
+                 "handtrack-synth --proportions varied)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--pose-far-mm", scene.far_mm, "Farthest palm depth of the random poses (from 250 mm)")
       ->check(CLI::Range(300.0, 1500.0))
       ->capture_default_str();
@@ -292,6 +301,7 @@ int main(int argc, char** argv) {
             << " --min-leaf " << train.min_leaf_samples << " --motion-fraction " << scene.motion_fraction
             << " --turned-fraction " << scene.turned_fraction << " --view-fraction " << scene.view_fraction
             << " --ball-fraction " << scene.ball_fraction << " --body-fraction " << scene.body_fraction
+            << " --varied-fraction " << scene.varied_fraction
             << " --pose-far-mm " << scene.far_mm
             << " --volume-far-mm " << scene.volume_far_mm << " --seed " << train.seed;
     const auto t1 = std::chrono::steady_clock::now();

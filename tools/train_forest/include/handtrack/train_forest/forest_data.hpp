@@ -60,6 +60,10 @@ struct SceneOptions {
   // torso), all of it background (label 0) to learn, so that the tracker drops it instead of
   // fitting a hand to it. Drawn last, so 0 leaves the data set unchanged.
   double body_fraction = 0.0;
+  // Share of the images whose hand has varied proportions (synth::Proportions::kVaried: every
+  // finger's length, the fingers' girth and the palm's thickness drawn beside the subject's size).
+  // Drawn from a stream of its own, so 0 leaves the data set unchanged.
+  double varied_fraction = 0.0;
   CameraIntrinsics camera = synth::default_camera();
 };
 
@@ -112,14 +116,16 @@ Confusion score_frame(const PartForest& forest, const DepthInput& input, const s
 
 // Held-out synthetic frames: each of the seven motion scripts with its own random subject
 // (seed = seed_base + motion index, backgrounds cycling body/table/none), `frames_per_motion`
-// frames spread over a 241-frame sequence (training uses 300-frame sequences), seen in `view`.
+// frames spread over a 241-frame sequence (training uses 300-frame sequences), seen in `view`, the
+// subjects' hands of `proportions` (synth::Proportions).
 struct HeldOutResult {
   std::array<Confusion, 7> per_motion;
   Confusion overall;
   int frames = 0;
 };
 HeldOutResult evaluate_motions(const PartForest& forest, uint64_t seed_base, int frames_per_motion,
-                               synth::View view = synth::View::kPalm);
+                               synth::View view = synth::View::kPalm,
+                               synth::Proportions proportions = synth::Proportions::kMean);
 // Held-out random poses: the scenes of data set `seed` (use one never trained on), `count` frames.
 Confusion evaluate_scenes(const PartForest& forest, uint64_t seed, int count, const SceneOptions& options);
 
