@@ -14,6 +14,7 @@
 #include "handtrack/eval/scoring.hpp"
 #include "handtrack/common/cli.hpp"
 #include "handtrack/tools/progress.hpp"
+#include "handtrack/tools/tracker_options.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -200,21 +201,13 @@ int main(int argc, char** argv) {
   app.add_option("--tips-csv", tips_file,
                  "write per-frame fingertips as CSV: sequence,frame,time_s,state, 15 estimated and 15 true "
                  "coordinates (mm; empty where not annotated); what scripts/filter-table smooths");
-  app.add_option("--hand", hand, "auto (default: both hands, the better fit chosen at every (re)start), right or left")
-      ->check(CLI::IsMember({"right", "left", "auto"}));
+  tools::add_hand_option(app, hand);
   std::string arrangement = "facing";
-  app.add_option("--arrangement", arrangement,
-                 "facing (default: a camera facing the user) or head-mounted (at the user's eyes): which side of a "
-                 "hand, and which hand on which side of the image, auto handedness expects where the depth leaves "
-                 "it open (handtrackd's tracker.arrangement)")
-      ->check(CLI::IsMember({"facing", "head-mounted"}));
+  tools::add_arrangement_option(app, arrangement);
   app.add_option("--energy", energy, "late-fusion (default, with the shipped forest) or depth-only")
       ->check(CLI::IsMember({"depth-only", "late-fusion"}));
   std::string forest_file;
-  app.add_option("--forest", forest_file,
-                 "part-classification forest for late fusion (default: the shipped one, $HANDTRACK_FOREST, "
-                 "data/ or /usr/share/handtrack)")
-      ->check(CLI::ExistingFile);
+  tools::add_forest_option(app, forest_file);
   app.add_option("--particles", config.particles, "pose particles per frame")->check(CLI::Range(1, 64));
   app.add_option("--iterations", config.optimizer.iterations, "optimizer iterations per particle")
       ->check(CLI::Range(1, 1000));

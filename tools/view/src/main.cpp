@@ -8,6 +8,7 @@
 #include "handtrack/core/png_io.hpp"
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/common/cli.hpp"
+#include "handtrack/tools/tracker_options.hpp"
 
 #include <CLI/CLI.hpp>
 #include <unistd.h>
@@ -278,18 +279,9 @@ int main(int argc, char** argv) {
                  "k_max of the surface fronts while late fusion tracks (default 1.5; 1: the paper's E_sim), as "
                  "handtrackd's tracker.energy.slant_front")
       ->check(CLI::Range(1.0, 10.0));
-  app.add_option("--arrangement", a.arrangement,
-                 "facing (default: a camera facing the user) or head-mounted (at the user's eyes), as handtrackd's "
-                 "tracker.arrangement")
-      ->check(CLI::IsMember({"facing", "head-mounted"}));
-  app.add_option("--hand", a.hand,
-                 "auto (default: both hands, the better fit chosen at every (re)start), right or left, as handtrackd's "
-                 "tracker.handedness")
-      ->check(CLI::IsMember({"right", "left", "auto"}));
-  app.add_option("--forest", a.forest,
-                 "part-classification forest for late fusion (default: the shipped one, $HANDTRACK_FOREST, data/ or "
-                 "/usr/share/handtrack)")
-      ->check(CLI::ExistingFile);
+  handtrack::tools::add_arrangement_option(app, a.arrangement);
+  handtrack::tools::add_hand_option(app, a.hand);
+  handtrack::tools::add_forest_option(app, a.forest);
   app.add_flag("--crop", a.crop, "Zoom all panels onto the segmented hand");
   app.add_option("--panel-height", a.panel_height, "Panel height in px (default: image height; 360 with --crop)")
       ->check(CLI::Range(32, 4096));

@@ -1,0 +1,40 @@
+#pragma once
+// The tracker options that handtrack-eval and handtrack-view share, spelt and checked as
+// handtrackd's configuration names their values (README, "Configuration"): the hand fitted, where
+// the camera looks from, and the part forest of late fusion.
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+namespace handtrack::tools {
+
+// --hand: tracker.handedness ("auto", "right" or "left"); `hand` keeps its value unless given.
+inline CLI::Option* add_hand_option(CLI::App& app, std::string& hand) {
+  return app
+      .add_option("--hand", hand,
+                  "auto (default: both hands, the better fit chosen at every (re)start), right or left, as "
+                  "handtrackd's tracker.handedness")
+      ->check(CLI::IsMember({"right", "left", "auto"}));
+}
+
+// --arrangement: tracker.arrangement ("facing" or "head-mounted").
+inline CLI::Option* add_arrangement_option(CLI::App& app, std::string& arrangement) {
+  return app
+      .add_option("--arrangement", arrangement,
+                  "facing (default: a camera facing the user) or head-mounted (at the user's eyes): which side of "
+                  "a hand, and which hand on which side of the image, auto handedness expects where the depth "
+                  "leaves it open (handtrackd's tracker.arrangement)")
+      ->check(CLI::IsMember({"facing", "head-mounted"}));
+}
+
+// --forest: tracker.forest_model; `forest` stays empty unless given (then the shipped one).
+inline CLI::Option* add_forest_option(CLI::App& app, std::string& forest) {
+  return app
+      .add_option("--forest", forest,
+                  "part-classification forest for late fusion (default: the shipped one, $HANDTRACK_FOREST, data/ "
+                  "or /usr/share/handtrack)")
+      ->check(CLI::ExistingFile);
+}
+
+}  // namespace handtrack::tools
