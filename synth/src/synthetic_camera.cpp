@@ -21,9 +21,9 @@ constexpr uint64_t kNoiseStream = 0x0015E;
 constexpr uint64_t kBodyStream = 0xB0D1;  // Background::kNearBody's build
 constexpr uint64_t kProportionStream = 0x960B0;
 constexpr double kSubjectSpread = 0.10;  // random subjects: scales within +-10 % (module brief)
-// Proportions::kVaried: each finger's length within +-6 % (about two standard deviations of a
-// finger's length relative to the hand's among adults), the fingers' girth and the palm's
-// thickness within +-15 %.
+// Proportions::kVaried, uniform draws: each finger's length within +-6 %, the fingers' girth and the
+// palm's thickness within +-15 % (chosen as plausible spreads between adult hands, not fitted to
+// anthropometric data).
 constexpr double kFingerLengthSpread = 0.06;
 constexpr double kGirthSpread = 0.15;
 // Two-hand scenes draw both hands into one z-buffer with hand k's solids labelled

@@ -14,7 +14,7 @@ namespace handtrack::forest {
 namespace {
 
 constexpr uint64_t kSceneStream = 0xF0E57;  // Rng::stream purpose of the scene draws
-constexpr uint64_t kProportionsStream = 0x960B0;  // ... and of SceneOptions::varied_fraction's
+constexpr uint64_t kProportionStream = 0x960B0;  // ... and of SceneOptions::varied_fraction's
 constexpr double kSubjectSpread = 0.10;      // subjects within +-10 % (as the synth's random subjects)
 constexpr int kTrainingSequenceFrames = 300;  // motion frames are drawn from 300-frame sequences
 constexpr int kHeldOutSequenceFrames = 241;   // held-out motions: other lengths, so other time samples
@@ -98,7 +98,7 @@ Scene make_scene(uint64_t seed, uint64_t index, const SceneOptions& options) {
     s.options.background = synth::Background::kNearBody;
   }
   if (options.varied_fraction > 0.0 &&
-      synth::Rng::stream(seed, index, kProportionsStream).uniform() < options.varied_fraction) {
+      synth::Rng::stream(seed, index, kProportionStream).uniform() < options.varied_fraction) {
     s.options.proportions = synth::Proportions::kVaried;
   }
   return s;
