@@ -232,7 +232,8 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
     }
     if (!std::all_of(given.finger_length.begin(), given.finger_length.end(), ok) || !ok(given.finger_girth) ||
         !ok(given.palm_thickness)) {
-      throw std::invalid_argument("subject proportions (finger lengths, girth, palm thickness) must be within [0.5, 2]");
+      throw std::invalid_argument(
+          "subject proportions (finger lengths, girth, palm thickness) must be within [0.5, 2]");
     }
     subjects.fill(*options.subject);
   } else {
@@ -242,7 +243,6 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
       subjects[k].length = rng.uniform(1.0 - kSubjectSpread, 1.0 + kSubjectSpread);
       subjects[k].width = rng.uniform(1.0 - kSubjectSpread, 1.0 + kSubjectSpread);
     }
-    options.subject = subjects[0];
   }
   if (options.proportions == Proportions::kVaried) {
     for (size_t k = 0; k < kTwoHands; ++k) {
@@ -251,8 +251,8 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
       subjects[k].finger_girth = rng.uniform(1.0 - kGirthSpread, 1.0 + kGirthSpread);
       subjects[k].palm_thickness = rng.uniform(1.0 - kGirthSpread, 1.0 + kGirthSpread);
     }
-    options.subject = subjects[0];
   }
+  options.subject = subjects[0];  // hand 0's, as options() reports it
   // The arrangement holds the forearm (views.hpp view_shape): a two-hand scene's for both hands.
   const View arrangement = seen_in(options.motion, options.view);
   const std::array<HandShape, kTwoHands> shapes{view_shape(arrangement, HandShape::for_subject(subjects[0])),

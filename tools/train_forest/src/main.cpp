@@ -66,13 +66,13 @@ struct EvalSummary {
 EvalSummary evaluate(const PartForest& model, int frames_per_motion, int scenes) {
   EvalSummary s;
   s.motions = forest::evaluate_motions(model, kHeldOutMotionSeed, frames_per_motion);
-  s.views[0] = s.motions.overall;
-  for (size_t v = 0; v < synth::kViews.size(); ++v) {
-    if (v > 0) s.views[v] = forest::evaluate_motions(model, kHeldOutMotionSeed, frames_per_motion, synth::kViews[v]).overall;
-    s.varied_views[v] = forest::evaluate_motions(model, kHeldOutMotionSeed, frames_per_motion, synth::kViews[v],
-                                                 synth::Proportions::kVaried)
-                            .overall;
-  }
+  const auto held_out = [&](size_t view, synth::Proportions proportions) {
+    return forest::evaluate_motions(model, kHeldOutMotionSeed, frames_per_motion, synth::kViews[view], proportions)
+        .overall;
+  };
+  s.views[0] = s.motions.overall;  // kViews[0] is palm, the held-out motions as evaluated above
+  for (size_t v = 1; v < synth::kViews.size(); ++v) s.views[v] = held_out(v, synth::Proportions::kMean);
+  for (size_t v = 0; v < synth::kViews.size(); ++v) s.varied_views[v] = held_out(v, synth::Proportions::kVaried);
   forest::SceneOptions facing;
   facing.turned_fraction = 0.0;
   facing.view_fraction = 0.0;
