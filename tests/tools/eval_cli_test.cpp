@@ -333,4 +333,59 @@ TEST_F(EvalCli, AOneHandSequenceIsTrackedAsHandtrackdTracksIt) {
   EXPECT_GT(differs_from_alone, 0) << "the scene must tell the two apart";
 }
 
+// --jobs: sequences tracked side by side, each by a tracker of its own, give the scores and
+// fingertips of one job, in the order given. A sequence that cannot be read fails the run with one
+// line naming it, whichever worker meets it.
+TEST_F(EvalCli, SequencesTrackedAtOnceScoreAsOneAtATime) {
+  std::string args;
+  for (const char* motion : {"pinch", "adbadd", "fingercount"}) {
+    handtrack::synth::SynthOptions o;
+    o.motion = motion;
+    o.frames = 12;
+    const fs::path seq = render(motion, o);
+    std::ofstream(seq / "hand.json") << nlohmann::json{{"hands", {"right"}}, {"view", "palm"}, {"motion", motion}}.dump();
+    args += "'" + seq.string() + "' ";
+  }
+  args += "--energy depth-only";
+  const auto run = [&](int jobs) {
+    const fs::path json = dir_ / ("eval-" + std::to_string(jobs) + ".json");
+    const fs::path tips = dir_ / ("tips-" + std::to_string(jobs) + ".csv");
+    std::string err;
+    EXPECT_EQ(eval(&err, args + " --jobs " + std::to_string(jobs) + " --json '" + json.string() + "' --tips-csv '" +
+                             tips.string() + "'"),
+              0)
+        << err;
+    std::ifstream in(json);
+    auto j = nlohmann::json::parse(in);
+    // Throughput is measured beside the other jobs: the one figure allowed to differ.
+    j.at("overall").erase("fps");
+    for (auto& s : j.at("sequences")) s.erase("fps");
+    for (auto& [key, groups] : j.at("groups").items()) {
+      for (auto& [name, group] : groups.items()) group.erase("fps");
+    }
+    std::ifstream t(tips);
+    return std::make_pair(j, std::string(std::istreambuf_iterator<char>(t), {}));
+  };
+  const auto [one_json, one_tips] = run(1);
+  const auto [three_json, three_tips] = run(3);
+  EXPECT_EQ(one_json, three_json);
+  EXPECT_EQ(one_tips, three_tips);
+  EXPECT_EQ(std::count(one_tips.begin(), one_tips.end(), '\n'), 1 + 3 * 12);
+  // In the order given: after the header, pinch's 12 rows, then adbadd's, then fingercount's.
+  std::stringstream rows(three_tips);
+  std::string row;
+  for (int line = 0; std::getline(rows, row); ++line) {
+    const char* expected = line == 0 ? "sequence," : line <= 12 ? "pinch," : line <= 24 ? "adbadd," : "fingercount,";
+    EXPECT_EQ(row.rfind(expected, 0), 0U) << "line " << line << ": " << row;
+  }
+  ASSERT_EQ(one_json.at("sequences").size(), 3U);
+  EXPECT_NE(one_json.at("sequences").at(0).at("name").get<std::string>().find("pinch"), std::string::npos);
+
+  std::ofstream(dir_ / "adbadd" / "depth" / "000005.png", std::ios::trunc) << "not a png";
+  std::string err;
+  EXPECT_EQ(eval(&err, args + " --jobs 3"), 1);
+  EXPECT_NE(err.find("000005.png"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+}
+
 }  // namespace

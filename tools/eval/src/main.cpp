@@ -18,14 +18,19 @@
 
 #include <CLI/CLI.hpp>
 
+#include <atomic>
 #include <chrono>
+#include <exception>
 #include <filesystem>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <mutex>
 #include <optional>
 #include <span>
+#include <sstream>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -100,15 +105,29 @@ void write_tips_row(std::ostream& out, const std::string& sequence, size_t frame
   out << '\n';
 }
 
-// What every sequence's frames share: the labeller (or the ground-truth labels behind
-// --oracle-labels), the --tips-csv file and the progress over all frames.
+// The progress over all sequences' frames, which the --jobs workers share.
+class SharedProgress {
+ public:
+  explicit SharedProgress(size_t total) : total_(total) {}
+  void frame_done(const std::string& sequence) {
+    const std::lock_guard lock(mutex_);
+    progress_.update(sequence, static_cast<double>(++done_) / static_cast<double>(total_));
+  }
+
+ private:
+  std::mutex mutex_;
+  tools::Progress progress_{kProgram};
+  size_t done_ = 0;
+  size_t total_;
+};
+
+// What one worker's sequences share: the labeller (or the ground-truth labels behind
+// --oracle-labels), the --tips-csv rows of the sequence at hand and the progress over all frames.
 struct FrameLoop {
   const PixelLabeller* labeller = nullptr;
   std::vector<uint8_t>* oracle_labels = nullptr;  // non-null: filled with each frame's labels/
-  std::ofstream* tips = nullptr;                  // open: --tips-csv
-  tools::Progress* progress = nullptr;
-  size_t done = 0;
-  size_t total = 0;
+  std::ostream* tips = nullptr;                   // non-null: --tips-csv
+  SharedProgress* progress = nullptr;
 
   // Tracks every frame of `reader` with track(depth) (timed) and hands its output to
   // score(i, output); returns the seconds spent tracking.
@@ -122,11 +141,11 @@ struct FrameLoop {
       const auto out = track(depth);
       seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       score(i, out);
-      progress->update(sequence_name(reader.dir()), static_cast<double>(++done) / static_cast<double>(total));
+      progress->frame_done(sequence_name(reader.dir()));
     }
     return seconds;
   }
-  [[nodiscard]] bool writes_tips() const { return tips != nullptr && tips->is_open(); }
+  [[nodiscard]] bool writes_tips() const { return tips != nullptr; }
 };
 
 // One hand (SPEC.md): HandsTracker with room for one, scored by SequenceScorer.
@@ -251,6 +270,11 @@ int main(int argc, char** argv) {
                "docs/TRACKER.md, \"Checks in the background\")");
   bool sim_only = false;
   app.add_flag("--sim-only", sim_only, "E_sim only: drop E_col, E_lim and E_smo (ablation of Fig. 6)");
+  int jobs = 1;
+  app.add_option("--jobs", jobs,
+                 "sequences tracked at once, each on a thread of its own (default 1); the scores are the same, "
+                 "the fps of each sequence is then measured beside the others")
+      ->check(CLI::Range(1, 256));
   int max_hands = kMaxHands;
   app.add_option("--max-hands", max_hands,
                  "hands HandsTracker may report (default 2, as handtrackd); a one-hand sequence is tracked with "
@@ -287,12 +311,7 @@ int main(int argc, char** argv) {
     if (!hand_profile.empty()) config.scale = load_hand_profile(hand_profile);
     std::optional<PartForest> forest;
     if (config.mode == EnergyMode::kLateFusion && !oracle_labels) forest.emplace(PartForest::load(forest_file));
-    // --oracle-labels: each frame's labels/NNNNNN.png through FixedLabels, which points at this.
-    std::vector<uint8_t> truth_labels;
-    const FixedLabels oracle(&truth_labels);
-    const PixelLabeller* labeller = forest ? static_cast<const PixelLabeller*>(&*forest) : nullptr;
-    if (config.mode == EnergyMode::kLateFusion && oracle_labels) labeller = &oracle;
-    std::vector<eval::SequenceScore> scores;
+    const bool use_oracle_labels = config.mode == EnergyMode::kLateFusion && oracle_labels;
     std::vector<SequenceReader> readers;
     size_t total_frames = 0;
     const bool hands_asked = app.count("--max-hands") > 0 && max_hands > 1;
@@ -321,20 +340,47 @@ int main(int argc, char** argv) {
       if (!tips_out) throw std::runtime_error(tips_file + ": cannot write");
       write_tips_header(tips_out);
     }
-    tools::Progress progress(kProgram);
-    FrameLoop loop;
-    loop.labeller = labeller;
-    loop.oracle_labels = labeller == &oracle ? &truth_labels : nullptr;
-    loop.tips = &tips_out;
-    loop.progress = &progress;
-    loop.total = total_frames;
-    for (const auto& reader : readers) {
-      const SequenceInfo info = read_sequence_info(reader);
-      scores.push_back(reader.hand_count() > 1 || hands_asked ? evaluate_hands(reader, info, config, max_hands, loop)
-                                                              : evaluate_one_hand(reader, info, config, loop));
-      scores.back().view = info.view;
-      scores.back().motion = info.motion;
+    // --jobs: workers take the sequences in turn, each tracked from its first frame by a tracker of
+    // its own, so every score is what one job gives; the results are gathered in the given order.
+    std::vector<eval::SequenceScore> scores(readers.size());
+    std::vector<std::string> tips_rows(readers.size());
+    std::vector<std::exception_ptr> failures(readers.size());
+    SharedProgress progress(total_frames);
+    std::atomic<size_t> next_sequence{0};
+    const auto work = [&] {
+      // --oracle-labels: each frame's labels/NNNNNN.png through FixedLabels, which points at this.
+      std::vector<uint8_t> truth_labels;
+      const FixedLabels oracle(&truth_labels);
+      FrameLoop loop;
+      loop.labeller = use_oracle_labels ? &oracle : forest ? static_cast<const PixelLabeller*>(&*forest) : nullptr;
+      loop.oracle_labels = use_oracle_labels ? &truth_labels : nullptr;
+      loop.progress = &progress;
+      for (size_t i = next_sequence++; i < readers.size(); i = next_sequence++) {
+        std::ostringstream tips;
+        loop.tips = tips_file.empty() ? nullptr : &tips;
+        try {
+          const SequenceInfo info = read_sequence_info(readers[i]);
+          scores[i] = readers[i].hand_count() > 1 || hands_asked
+                          ? evaluate_hands(readers[i], info, config, max_hands, loop)
+                          : evaluate_one_hand(readers[i], info, config, loop);
+          scores[i].view = info.view;
+          scores[i].motion = info.motion;
+        } catch (...) {
+          failures[i] = std::current_exception();
+          next_sequence = readers.size();  // the run fails: no worker starts another sequence
+        }
+        tips_rows[i] = std::move(tips).str();
+      }
+    };
+    {
+      std::vector<std::jthread> helpers;
+      for (int j = 1; j < std::min(jobs, static_cast<int>(readers.size())); ++j) helpers.emplace_back(work);
+      work();
     }
+    for (const auto& failure : failures) {
+      if (failure) std::rethrow_exception(failure);
+    }
+    for (const auto& rows : tips_rows) tips_out << rows;
     const auto total = eval::overall(scores);
     // A mean over no frame is not a result: every annotated frame got no pose (or a NaN one). Nor is
     // a handedness over no frame, where nothing is annotated.
