@@ -62,8 +62,8 @@ class EvalCli : public ::testing::Test {
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   }
 
-  // Renders a one-hand synthetic sequence into dir_ / name, with its ground-truth fingertips unless
-  // told otherwise.
+  // Renders a one-hand synthetic sequence into dir_ / name, with its ground-truth fingertips and
+  // joints unless told otherwise.
   fs::path render(const std::string& name, const handtrack::synth::SynthOptions& options,
                   bool fingertips = true) const {
     handtrack::synth::SyntheticCamera cam(options);
@@ -71,7 +71,10 @@ class EvalCli : public ::testing::Test {
     for (int f = 0; f < options.frames; ++f) {
       const auto frame = cam.render(f);
       writer.write_depth(f, frame.depth);
-      if (fingertips) writer.write_fingertips(f, frame.fingertips);
+      if (fingertips) {
+        writer.write_fingertips(f, frame.fingertips);
+        writer.write_joints(f, frame.joints);
+      }
     }
     writer.flush();
     return dir_ / name;
@@ -126,6 +129,14 @@ TEST_F(EvalCli, GroupsSequencesByTheViewMotionAndHandTheirHandJsonNames) {
   EXPECT_EQ(g.at("motion").at("pinch").at("frames").get<int>(), 10);
   EXPECT_EQ(g.at("hand").at("left").at("frames").get<int>(), 4);
   EXPECT_LT(g.at("view").at("palm").at("mean_fingertip_error_mm").get<double>(), 30.0);
+  // joints.csv scored too: the rendered sequences' 12 frames (the empty one has no joints.csv), the
+  // tips among the joints where the fingertips are.
+  const auto& joints = g.at("view").at("palm").at("joints");
+  EXPECT_EQ(joints.at("frames_scored"), 12);
+  EXPECT_NEAR(joints.at("mean_error_by_kind_mm").at("tip").get<double>(),
+              g.at("view").at("palm").at("mean_fingertip_error_mm").get<double>(), 1e-6);
+  EXPECT_LT(joints.at("mean_error_mm").get<double>(), 30.0);
+  EXPECT_EQ(j.at("sequences").at(2).at("joints").at("frames_scored"), 0);
   EXPECT_EQ(j.at("sequences").at(2).at("view"), "head-mounted");
   EXPECT_DOUBLE_EQ(j.at("overall").at("pct_frames_without_pose").get<double>(), 100.0 * 4 / 16);
 }
@@ -143,7 +154,10 @@ TEST_F(EvalCli, ATwoHandSequenceIsScoredPerHandAndAOneHandOneOnlyWhenAsked) {
     for (int f = 0; f < o.frames; ++f) {
       const auto frame = cam.render(f);
       writer.write_depth(f, frame.depth);
-      for (int h = 0; h < frame.hand_count; ++h) writer.write_fingertips(f, frame.hands[static_cast<size_t>(h)].fingertips, h);
+      for (int h = 0; h < frame.hand_count; ++h) {
+        writer.write_fingertips(f, frame.hands[static_cast<size_t>(h)].fingertips, h);
+        writer.write_joints(f, frame.hands[static_cast<size_t>(h)].joints, h);
+      }
     }
   }
   const fs::path json = dir_ / "eval.json", tips = dir_ / "tips.csv";
@@ -168,6 +182,10 @@ TEST_F(EvalCli, ATwoHandSequenceIsScoredPerHandAndAOneHandOneOnlyWhenAsked) {
       EXPECT_LT(hands.at(k).at("mean_fingertip_error_mm").get<double>(), 30.0);
       EXPECT_TRUE(hands.at(k).contains("identity_swaps_per_1000_frames"));
       EXPECT_TRUE(hands.at(k).at("handedness").contains("pct_frames_correct"));
+      // Each hand's joints against the hand matched to it: its tips are its fingertips.
+      EXPECT_EQ(hands.at(k).at("joints").at("frames_scored"), 8 - hands.at(k).at("misses").get<int>());
+      EXPECT_NEAR(hands.at(k).at("joints").at("mean_error_by_kind_mm").at("tip").get<double>(),
+                  hands.at(k).at("mean_fingertip_error_mm").get<double>(), 1e-6);
     }
     EXPECT_TRUE(seq.contains("phantom_frames"));
     EXPECT_EQ(j.at("overall").at("hands").size(), 2U);

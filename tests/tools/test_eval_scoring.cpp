@@ -1,11 +1,14 @@
 // handtrack-eval's scoring of several hands (tools/eval/src/scoring.cpp, issue 14) on hand-made
 // frames whose right answer is known: which tracked hand is matched to which ground-truth hand, and
-// what each ground-truth hand's misses, wrong sides, identity swaps and the phantoms add up to.
+// what each ground-truth hand's misses, wrong sides, identity swaps and the phantoms add up to. And
+// the joint errors: each kind of joint's and the 21 joints' mean, over the frames that can be scored.
 #include "handtrack/eval/scoring.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 #include <vector>
 
 namespace handtrack::eval {
@@ -167,6 +170,85 @@ TEST(HandsScoring, OneHandScoresHaveNoHandsInTheirJson) {
   EXPECT_FALSE(j.at("overall").contains("hands"));
   EXPECT_FALSE(j.at("overall").contains("phantom_frames"));
   EXPECT_EQ(format_table({s}, overall({s})).find("per hand"), std::string::npos);
+}
+
+// 21 joints spread over a hand near `centre`, and a tracked hand whose wrist is `wrist_mm` off and
+// whose k-th joint of every finger (MCP, PIP, DIP, TIP) is `k_mm[k]` off, each along another axis.
+Joints joints_at(const Vector3d& centre) {
+  Joints joints;
+  for (size_t j = 0; j < joints.size(); ++j) joints[j] = centre + Vector3d(7.0 * j, -5.0 * j, 2.0 * j);
+  return joints;
+}
+TrackerOutput tracked_joints(const Joints& truth, double wrist_mm, const std::array<double, 4>& k_mm) {
+  TrackerOutput out;
+  out.state = TrackingState::kTracking;
+  out.joints = truth;
+  out.joints[kWristJoint] += Vector3d(0, 0, wrist_mm);
+  for (int f = 0; f < kNumFingers; ++f) {
+    for (int k = 0; k < 4; ++k) {
+      const Vector3d axis = f % 2 == 0 ? Vector3d::UnitX() : Vector3d::UnitY();
+      out.joints[static_cast<size_t>(joint_index(f, k))] += k_mm[static_cast<size_t>(k)] * axis;
+    }
+  }
+  return out;
+}
+
+TEST(JointScoring, EachKindIsTheMeanOfItsJointsAndAllTheMeanOfTheTwentyOne) {
+  const Joints truth = joints_at({0, 0, 400});
+  SequenceScorer scorer("joints", Handedness::kRight);
+  scorer.add(tracked_joints(truth, 10.0, {2.0, 4.0, 6.0, 8.0}), kRight, truth);
+  // Not scored on their joints: a frame without a pose, one with a NaN pose, one without joints.
+  scorer.add(TrackerOutput{}, kRight, truth);
+  TrackerOutput nan_pose = tracked_joints(truth, 50.0, {50.0, 50.0, 50.0, 50.0});
+  nan_pose.params[3] = std::numeric_limits<double>::quiet_NaN();
+  scorer.add(nan_pose, kRight, truth);
+  scorer.add(tracked_joints(truth, 50.0, {50.0, 50.0, 50.0, 50.0}), kRight);
+  const SequenceScore s = scorer.finish(0.1);
+  EXPECT_EQ(s.joints.frames, 1);
+  const std::array<double, 5> kinds = {10.0, 2.0, 4.0, 6.0, 8.0};
+  for (size_t k = 0; k < kinds.size(); ++k) EXPECT_NEAR(s.joints.kind_mean_mm(k), kinds[k], 1e-9) << kJointKinds[k];
+  EXPECT_NEAR(s.joints.mean_mm(), (10.0 + 5 * (2.0 + 4.0 + 6.0 + 8.0)) / 21, 1e-9);
+
+  // Pooled with a sequence without joints.csv, and in the JSON; none scored is null, not 0.
+  SequenceScorer other("no joints");
+  other.add(tracked_joints(truth, 30.0, {30.0, 30.0, 30.0, 30.0}), kRight);
+  const SequenceScore without = other.finish(0.1);
+  EXPECT_TRUE(std::isnan(without.joints.mean_mm()));
+  const nlohmann::json j = to_json({s, without}, overall({s, without}));
+  const auto& all = j.at("overall").at("joints");
+  EXPECT_EQ(all.at("frames_scored"), 1);
+  EXPECT_NEAR(all.at("mean_error_mm").get<double>(), 110.0 / 21, 1e-9);
+  EXPECT_NEAR(all.at("mean_error_by_kind_mm").at("wrist").get<double>(), 10.0, 1e-9);
+  EXPECT_NEAR(all.at("mean_error_by_kind_mm").at("tip").get<double>(), 8.0, 1e-9);
+  EXPECT_TRUE(j.at("sequences").at(1).at("joints").at("mean_error_mm").is_null());
+  EXPECT_NE(format_table({s, without}, overall({s, without})).find("joint error"), std::string::npos);
+  EXPECT_EQ(format_table({without}, overall({without})).find("joint error"), std::string::npos)
+      << "no joint table where no sequence has joints";
+}
+
+TEST(JointScoring, EachGroundTruthHandIsScoredOnTheHandMatchedToIt) {
+  const Joints right_joints = joints_at({-100, 0, 400});
+  const Joints left_joints = joints_at({100, 0, 420});
+  HandsScorer scorer("pair", {Handedness::kRight, Handedness::kLeft});
+  // The slots in the other order: the left hand's fit comes first. Then the left hand is missed.
+  TrackerOutput right = tracked_joints(right_joints, 4.0, {4.0, 4.0, 4.0, 4.0});
+  TrackerOutput left = tracked_joints(left_joints, 12.0, {12.0, 12.0, 12.0, 12.0});
+  right.fingertips = tracked(kRight, {0, 0, 0}, 1).fingertips;
+  left.fingertips = tracked(kLeft, {0, 0, 0}, 2).fingertips;
+  const std::vector<Fingertips> tips = {kRight, kLeft};
+  const std::vector<std::optional<Joints>> joints = {right_joints, left_joints};
+  scorer.add(std::vector<TrackerOutput>{left, right}, tips, joints);
+  scorer.add(std::vector<TrackerOutput>{right}, tips, joints);
+  const SequenceScore s = scorer.finish(0.1);
+  EXPECT_EQ(s.hands[0].joints.frames, 2);
+  EXPECT_NEAR(s.hands[0].joints.mean_mm(), 4.0, 1e-9);
+  EXPECT_EQ(s.hands[1].joints.frames, 1) << "a missed hand is not scored on its joints";
+  EXPECT_NEAR(s.hands[1].joints.mean_mm(), 12.0, 1e-9);
+  EXPECT_EQ(s.joints.frames, 3);
+  EXPECT_NEAR(s.joints.mean_mm(), (4.0 + 4.0 + 12.0) / 3, 1e-9);
+  // Joints for one hand of two is a caller's mistake.
+  EXPECT_THROW(scorer.add(std::vector<TrackerOutput>{right}, tips, std::vector<std::optional<Joints>>{right_joints}),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -164,7 +164,7 @@ eval::SequenceScore evaluate_one_hand(const SequenceReader& reader, const Sequen
   const double seconds = loop.run(
       reader, track,
       [&](size_t i, const TrackerOutput& out) {
-        scorer.add(out, reader.fingertips(i));
+        scorer.add(out, reader.fingertips(i), reader.joints(i));
         if (loop.writes_tips()) {
           write_tips_row(*loop.tips, name, i, static_cast<double>(i) / reader.camera().fps, out, reader.fingertips(i));
         }
@@ -182,12 +182,16 @@ eval::SequenceScore evaluate_hands(const SequenceReader& reader, const SequenceI
   const std::string name = sequence_name(reader.dir());
   eval::HandsScorer scorer(name, info.hands);
   std::vector<Fingertips> truth(info.hands.size());
+  std::vector<std::optional<Joints>> joints(info.hands.size());
   const double seconds = loop.run(
       reader, [&](const DepthImage& depth) { return tracker.track(depth, loop.labeller); },
       [&](size_t i, const HandsOutput& out) {
-        for (size_t k = 0; k < truth.size(); ++k) truth[k] = reader.fingertips(i, static_cast<int>(k));
+        for (size_t k = 0; k < truth.size(); ++k) {
+          truth[k] = reader.fingertips(i, static_cast<int>(k));
+          joints[k] = reader.joints(i, static_cast<int>(k));
+        }
         const std::span<const TrackerOutput> tracked(out.hands.data(), static_cast<size_t>(out.count));
-        const eval::HandMatch match = scorer.add(tracked, truth);
+        const eval::HandMatch match = scorer.add(tracked, truth, joints);
         if (!loop.writes_tips()) return;
         for (size_t k = 0; k < truth.size(); ++k) {
           const int t = match.tracked_of_truth[k];

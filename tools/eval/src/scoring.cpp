@@ -23,8 +23,44 @@ double fingertip_error_mm(const TrackerOutput& out, const Fingertips& truth) {
   return sum / n;
 }
 
-void SequenceScorer::add(const TrackerOutput& out, const Fingertips& truth) {
+void JointErrors::add(const Joints& tracked, const Joints& truth) {
+  const auto error = [&](int joint) {
+    return (tracked[static_cast<size_t>(joint)] - truth[static_cast<size_t>(joint)]).norm();
+  };
+  double all = error(kWristJoint);
+  kind_sum_mm[0] += error(kWristJoint);
+  for (int k = 0; k < 4; ++k) {
+    double kind = 0.0;
+    for (int f = 0; f < kNumFingers; ++f) kind += error(joint_index(f, k));
+    kind_sum_mm[static_cast<size_t>(k) + 1] += kind / kNumFingers;
+    all += kind;
+  }
+  sum_mm += all / kNumJoints;
+  ++frames;
+}
+
+void JointErrors::add(const JointErrors& other) {
+  frames += other.frames;
+  sum_mm += other.sum_mm;
+  for (size_t k = 0; k < kind_sum_mm.size(); ++k) kind_sum_mm[k] += other.kind_sum_mm[k];
+}
+
+double JointErrors::mean_mm() const {
+  return frames > 0 ? sum_mm / frames : std::numeric_limits<double>::quiet_NaN();
+}
+
+double JointErrors::kind_mean_mm(size_t kind) const {
+  return frames > 0 ? kind_sum_mm.at(kind) / frames : std::numeric_limits<double>::quiet_NaN();
+}
+
+namespace {
+// A pose to score joints on: reported, and finite (a NaN pose is counted as such, not scored).
+bool scorable(const TrackerOutput& out) { return out.state != TrackingState::kNoHand && out.params.allFinite(); }
+}  // namespace
+
+void SequenceScorer::add(const TrackerOutput& out, const Fingertips& truth, const std::optional<Joints>& joints) {
   ++score_.frames;
+  if (joints && scorable(out)) score_.joints.add(out.joints, *joints);
   if (!out.params.allFinite()) ++score_.nan_poses;
   if (out.detection_guided_won) ++score_.guided_wins;
   if (out.state != TrackingState::kNoHand) {
@@ -105,6 +141,7 @@ SequenceScore overall(const std::vector<SequenceScore>& sequences) {
     all.left_frames += s.left_frames;
     all.hand_known_frames += s.hand_known_frames;
     all.hand_correct += s.hand_correct;
+    all.joints.add(s.joints);
     all.per_frame_error_mm.insert(all.per_frame_error_mm.end(), s.per_frame_error_mm.begin(),
                                   s.per_frame_error_mm.end());
     if (s.fps > 0.0) seconds += s.frames / s.fps;
@@ -180,9 +217,11 @@ HandsScorer::HandsScorer(std::string name, const std::vector<std::optional<Hande
   }
 }
 
-HandMatch HandsScorer::add(std::span<const TrackerOutput> tracked, std::span<const Fingertips> truth) {
-  if (truth.size() != score_.hands.size()) {
-    throw std::invalid_argument("HandsScorer::add: " + std::to_string(truth.size()) + " ground-truth hands, expected " +
+HandMatch HandsScorer::add(std::span<const TrackerOutput> tracked, std::span<const Fingertips> truth,
+                           std::span<const std::optional<Joints>> joints) {
+  if (truth.size() != score_.hands.size() || (!joints.empty() && joints.size() != truth.size())) {
+    throw std::invalid_argument("HandsScorer::add: " + std::to_string(truth.size()) + " ground-truth hands (" +
+                                std::to_string(joints.size()) + " with joints), expected " +
                                 std::to_string(score_.hands.size()));
   }
   ++score_.frames;
@@ -221,6 +260,7 @@ HandMatch HandsScorer::add(std::span<const TrackerOutput> tracked, std::span<con
     if (t >= 0) {
       const TrackerOutput& out = tracked[static_cast<size_t>(t)];
       id = out.hand_id;
+      if (!joints.empty() && joints[g] && scorable(out)) hand.joints.add(out.joints, *joints[g]);
       ++hand.posed_frames;
       hand.left_frames += out.handedness == Handedness::kLeft ? 1 : 0;
       if (hand.expected_hand) {
@@ -245,6 +285,7 @@ HandMatch HandsScorer::add(std::span<const TrackerOutput> tracked, std::span<con
 SequenceScore HandsScorer::finish(double tracking_seconds) {
   score_.posed_frames = score_.left_frames = score_.hand_known_frames = score_.hand_correct = 0;
   score_.identity_swaps = 0;
+  score_.joints = {};
   for (auto& hand : score_.hands) {
     summarise(hand);
     hand.fps = tracking_seconds > 0.0 ? hand.frames / tracking_seconds : 0.0;
@@ -253,6 +294,7 @@ SequenceScore HandsScorer::finish(double tracking_seconds) {
     score_.hand_known_frames += hand.hand_known_frames;
     score_.hand_correct += hand.hand_correct;
     score_.identity_swaps += hand.identity_swaps;
+    score_.joints.add(hand.joints);
   }
   summarise(score_);
   score_.fps = tracking_seconds > 0.0 ? score_.frames / tracking_seconds : 0.0;
@@ -312,6 +354,32 @@ std::string format_table(const std::vector<SequenceScore>& sequences, const Sequ
     text += "\nby " + g.by + ":\n";
     for (const auto& s : g.groups) row(s);
   }
+  // Where sequences have joints.csv: the joint errors of the overall row and of each group's.
+  if (total.joints.frames > 0) {
+    std::snprintf(line, sizeof line, "\njoint error, mm (frames with a pose and joints.csv):\n%-14s %7s %9s", "pooled",
+                  "frames", "all");
+    text += line;
+    for (const char* kind : kJointKinds) {
+      std::snprintf(line, sizeof line, " %6s", kind);
+      text += line;
+    }
+    text += '\n';
+    const auto joint_row = [&](const SequenceScore& s) {
+      std::snprintf(line, sizeof line, "%-14s %7d %9s", s.name.c_str(), s.joints.frames,
+                    figure(s.joints.mean_mm(), "%.2f").c_str());
+      text += line;
+      for (size_t k = 0; k < kJointKinds.size(); ++k) {
+        std::snprintf(line, sizeof line, " %6s", figure(s.joints.kind_mean_mm(k), "%.1f").c_str());
+        text += line;
+      }
+      text += '\n';
+    };
+    joint_row(total);
+    for (const auto& g : groups) {
+      text += "by " + g.by + ":\n";
+      for (const auto& s : g.groups) joint_row(s);
+    }
+  }
   // Scored per hand: a row per ground-truth hand (missed frames, the share reported on the right
   // side, identity swaps), and the phantom hands of the sequence.
   const bool per_hand = std::any_of(sequences.begin(), sequences.end(), [](const auto& s) { return !s.hands.empty(); });
@@ -360,6 +428,13 @@ nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const Sequen
     if (s.expected_hand) j["expected"] = to_string(*s.expected_hand);
     return j;
   };
+  // The frames scored on their joints, the mean over all 21 and over each kind's (null: none).
+  const auto joint_scores = [&](const JointErrors& e) {
+    nlohmann::json by_kind = nlohmann::json::object();
+    for (size_t k = 0; k < kJointKinds.size(); ++k) by_kind[kJointKinds[k]] = number(e.kind_mean_mm(k));
+    return nlohmann::json{{"frames_scored", e.frames}, {"mean_error_mm", number(e.mean_mm())},
+                          {"mean_error_by_kind_mm", by_kind}};
+  };
   // A frame that shows a hand but gets no pose is a miss (SPEC.md): its share of the annotated frames.
   const auto scores = [&](const SequenceScore& s) {
     const int annotated = s.scored + s.without_pose;
@@ -374,6 +449,7 @@ nlohmann::json to_json(const std::vector<SequenceScore>& sequences, const Sequen
                           {"max_fingertip_error_mm", number(s.max_error_mm)},
                           {"pct_frames_below_mm", pct(s)},
                           {"handedness", hands(s)},
+                          {"joints", joint_scores(s.joints)},
                           {"fps", s.fps}};
   };
   // Scored per hand: each ground-truth hand's scores, its misses and identity swaps (also per 1000

@@ -28,6 +28,27 @@ inline constexpr std::array<int, 4> kThresholdsMm = {15, 20, 25, 30};
 // annotated. A frame without a pose (state no_hand) scores +infinity: it is below no threshold.
 double fingertip_error_mm(const TrackerOutput& out, const Fingertips& truth);
 
+// The 21 joints (SPEC.md: joints.csv) by their place on the hand, each scored apart besides the
+// paper's fingertips: the wrist, then each finger's joints from its base (the thumb's CMC, MCP and
+// IP in the places of the other fingers' MCP, PIP and DIP). Where the fingertips' error comes from:
+// a hand placed or turned wrongly moves the wrist and the bases, a wrong flexion only the joints
+// beyond them.
+inline constexpr std::array<const char*, 5> kJointKinds = {"wrist", "mcp", "pip", "dip", "tip"};
+
+// The joint errors of the frames with a pose and annotated joints, summed: per frame the mean
+// distance over all 21 joints (the mean joint error of the hand-pose literature) and over each
+// kind's joints.
+struct JointErrors {
+  int frames = 0;
+  double sum_mm = 0.0;
+  std::array<double, kJointKinds.size()> kind_sum_mm{};
+
+  void add(const Joints& tracked, const Joints& truth);
+  void add(const JointErrors& other);
+  [[nodiscard]] double mean_mm() const;                    // NaN: no frame
+  [[nodiscard]] double kind_mean_mm(size_t kind) const;  // likewise
+};
+
 struct SequenceScore {
   std::string name;
   int frames = 0;              // frames tracked
@@ -60,6 +81,8 @@ struct SequenceScore {
   int identity_swaps = 0;  // a hand's matched hand_id changed between two consecutive matched frames
   int phantom_frames = 0;  // frames with a tracked hand matched to no ground-truth hand
   int phantom_hands = 0;   // such tracked hands, summed over the frames
+  // Where the sequence has joints.csv: its frames' joint errors (HandsScorer: all hands').
+  JointErrors joints;
 };
 
 // Sequences pooled by a property (overall() of each group), e.g. "view" -> {"back": ..., "palm": ...}.
@@ -77,7 +100,8 @@ class SequenceScorer {
     score_.name = std::move(name);
     score_.expected_hand = expected_hand;
   }
-  void add(const TrackerOutput& out, const Fingertips& truth);
+  // One frame: the fingertips annotated, and the 21 joints where the sequence has them.
+  void add(const TrackerOutput& out, const Fingertips& truth, const std::optional<Joints>& joints = std::nullopt);
   SequenceScore finish(double tracking_seconds);
 
  private:
@@ -115,8 +139,10 @@ class HandsScorer {
   // the sequence does not say).
   HandsScorer(std::string name, const std::vector<std::optional<Handedness>>& truth_hands);
   // One frame: the tracked hands and each ground-truth hand's fingertips (truth.size() = the hands
-  // given to the constructor). Returns the frame's match.
-  HandMatch add(std::span<const TrackerOutput> tracked, std::span<const Fingertips> truth);
+  // given to the constructor), and its joints where the sequence has them (empty, or one per hand).
+  // Returns the frame's match.
+  HandMatch add(std::span<const TrackerOutput> tracked, std::span<const Fingertips> truth,
+                std::span<const std::optional<Joints>> joints = {});
   SequenceScore finish(double tracking_seconds);
 
  private:
