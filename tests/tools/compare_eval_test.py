@@ -12,9 +12,12 @@ script, work = sys.argv[1], sys.argv[2]
 os.makedirs(work, exist_ok=True)
 
 
-def score(mean, right, below30=90.0):
-    return {"mean_fingertip_error_mm": mean, "pct_frames_below_mm": {"30": below30}, "pct_frames_without_pose": 0.0,
-            "handedness": {"frames_with_pose": 300, "pct_frames_correct": right}}
+def score(mean, right, below30=90.0, joints=None):
+    s = {"mean_fingertip_error_mm": mean, "pct_frames_below_mm": {"30": below30}, "pct_frames_without_pose": 0.0,
+         "handedness": {"frames_with_pose": 300, "pct_frames_correct": right}}
+    if joints is not None:
+        s["joints"] = {"frames_scored": 300, "mean_error_mm": joints}
+    return s
 
 
 def write(name, sequences, overall):
@@ -39,15 +42,17 @@ def check(condition, what):
 
 
 before = write("before.json", {"steady": (10.0, 100.0), "better": (30.0, 60.0), "worse": (8.0, 100.0)},
-               score(16.0, 86.67))
+               score(16.0, 86.67, joints=12.0))
 after = write("after.json", {"steady": (10.5, 100.0), "better": (20.0, 99.0), "worse": (12.0, 100.0)},
-              score(14.17, 99.67))
+              score(14.17, 99.67, joints=11.5))
 code, out, err = run(before, after)
 check(code == 0, f"exit {code}: {err}")
-check("| all (3 sequences) | 16.00 -> 14.17 | 90.00 | 0.00 | 86.67 -> 99.67 |" in out, "overall row:\n" + out)
+check("| all (3 sequences) | 16.00 -> 14.17 | 90.00 | 0.00 | 86.67 -> 99.67 | 12.00 -> 11.50 |" in out,
+      "overall row:\n" + out)
 check("| view back | 16.00 -> 14.17 |" in out, "group row:\n" + out)
 check("2 of 3 sequences moved by more than 2 mm or 1 point of handedness: 1 gained, 1 lost." in out, out)
-check("| better | 30.00 -> 20.00 | 90.00 | 0.00 | 60.00 -> 99.00 |" in out, "moved row:\n" + out)
+check("| better | 30.00 -> 20.00 | 90.00 | 0.00 | 60.00 -> 99.00 | - |" in out,
+      "moved row, no joints scored:\n" + out)
 check("| worse | 8.00 -> 12.00 |" in out, "moved row:\n" + out)
 check("| steady |" not in out, "a sequence within the limits is not listed:\n" + out)
 
