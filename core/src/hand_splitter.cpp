@@ -200,7 +200,9 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
   // Each slot's surface(s): an active slot its claimed ones, a free slot one new one.
   std::array<int, kMaxHands> new_surface{};
   new_surface.fill(kNone);
-  std::vector<int>& order = stack_;  // candidates, nearest first
+  // The free slots' candidates, nearest first: big enough, not a body reaching through the far
+  // plane, not where a surface was recently found to be no hand.
+  std::vector<int>& order = stack_;
   order.clear();
   for (size_t c = 0; c < surfaces_.size(); ++c) {
     const Surface& s = surfaces_[c];

@@ -77,9 +77,6 @@ class HandSplitter {
   static constexpr int kNone = -1;
 
   void claim(const DepthInputConfig& config, const CameraIntrinsics& camera, const HandsRequest& request);
-  // The free slots' surfaces: nearest first, big enough, not a body reaching through the far plane,
-  // not where a surface was recently found to be no hand.
-  void choose_new(const DepthInputConfig& config, const CameraIntrinsics& camera, const HandsRequest& request);
 
   std::vector<Ownership> ownership_;  // per surface
   MedianFilter median_;
