@@ -27,9 +27,10 @@ void JointErrors::add(const Joints& tracked, const Joints& truth) {
   const auto error = [&](int joint) {
     return (tracked[static_cast<size_t>(joint)] - truth[static_cast<size_t>(joint)]).norm();
   };
-  double all = error(kWristJoint);
-  kind_sum_mm[0] += error(kWristJoint);
-  for (int k = 0; k < 4; ++k) {
+  const double wrist = error(kWristJoint);
+  double all = wrist;
+  kind_sum_mm[0] += wrist;
+  for (int k = 0; k + 1 < static_cast<int>(kJointKinds.size()); ++k) {  // each finger's k-th joint from its base
     double kind = 0.0;
     for (int f = 0; f < kNumFingers; ++f) kind += error(joint_index(f, k));
     kind_sum_mm[static_cast<size_t>(k) + 1] += kind / kNumFingers;
