@@ -23,6 +23,7 @@
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -114,12 +115,28 @@ TEST_F(EvalCli, GroupsSequencesByTheViewMotionAndHandTheirHandJsonNames) {
     describe(render(motion, o), "right", "palm", motion);
   }
   describe(dir_ / "seq", "left", "head-mounted", "pinch");
-  const fs::path json = dir_ / "eval.json";
+  const fs::path json = dir_ / "eval.json", joints_csv = dir_ / "joints.csv";
   std::string err;
   ASSERT_EQ(eval(&err, "'" + (dir_ / "pinch").string() + "' '" + (dir_ / "adbadd").string() + "' '" +
-                           (dir_ / "seq").string() + "' --json '" + json.string() + "'"),
+                           (dir_ / "seq").string() + "' --json '" + json.string() + "' --joints-csv '" +
+                           joints_csv.string() + "'"),
             0)
       << err;
+  {
+    // --joints-csv: a header, then a row per frame with 21 estimated and 21 true joints (63 + 63
+    // cells after the 4 first), the true ones empty where the sequence has no joints.csv.
+    std::ifstream in(joints_csv);
+    std::string line;
+    std::vector<std::string> rows;
+    while (std::getline(in, line)) rows.push_back(line);
+    ASSERT_EQ(rows.size(), 1U + 6 + 6 + 4);
+    EXPECT_EQ(rows[0].rfind("sequence,frame,time_s,state,est_wrist_x,", 0), 0U) << rows[0];
+    EXPECT_NE(rows[0].find(",true_little_tip_z"), std::string::npos);
+    for (const auto& row : rows) EXPECT_EQ(std::count(row.begin(), row.end(), ','), 3 + 2 * 63) << row;
+    EXPECT_EQ(rows[1].rfind("pinch,0,", 0), 0U) << rows[1];
+    EXPECT_EQ(rows[1].find(",,"), std::string::npos) << "every joint annotated: " << rows[1];
+    EXPECT_NE(rows.back().find(std::string(63, ',')), std::string::npos) << "no joints.csv: " << rows.back();
+  }
   std::ifstream in(json);
   const auto j = nlohmann::json::parse(in);
   const auto& g = j.at("groups");

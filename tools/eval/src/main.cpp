@@ -31,6 +31,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -80,29 +81,64 @@ SequenceInfo read_sequence_info(const SequenceReader& reader) {
   return info;
 }
 
-// --tips-csv: one row per frame with the estimated and the true fingertips.
-void write_tips_header(std::ostream& out) {
-  out << "sequence,frame,time_s,state";
-  for (const char* kind : {"est", "true"}) {
-    for (int f = 0; f < kNumFingers; ++f) {
-      for (const char axis : {'x', 'y', 'z'}) out << ',' << kind << f << '_' << axis;
-    }
+// --tips-csv and --joints-csv: one row per frame with the estimated and the true points (mm),
+// each point's columns named KIND STEM _AXIS: est0_x, ... true4_z for the fingertips (thumb..little),
+// est_wrist_x, ... true_little_tip_z for the joints (SPEC.md's order). A true point not annotated is
+// left empty.
+struct PointColumns {
+  std::vector<std::string> stems;  // one per point
+  static PointColumns fingertips() {
+    PointColumns c;
+    for (int f = 0; f < kNumFingers; ++f) c.stems.push_back(std::to_string(f));
+    return c;
   }
-  out << '\n';
-}
+  static PointColumns joints() {
+    PointColumns c;
+    for (int j = 0; j < kNumJoints; ++j) c.stems.push_back("_" + std::string(joint_name(j)));
+    return c;
+  }
+  void write_header(std::ostream& out) const {
+    out << "sequence,frame,time_s,state";
+    for (const char* kind : {"est", "true"}) {
+      for (const auto& stem : stems) {
+        for (const char axis : {'x', 'y', 'z'}) out << ',' << kind << stem << '_' << axis;
+      }
+    }
+    out << '\n';
+  }
+};
 
-void write_tips_row(std::ostream& out, const std::string& sequence, size_t frame, double time_s,
-                    const TrackerOutput& estimate, const Fingertips& truth) {
-  out << sequence << ',' << frame << ',' << time_s << ',' << static_cast<int>(estimate.state);
-  for (const auto& tip : estimate.fingertips) out << ',' << tip.x() << ',' << tip.y() << ',' << tip.z();
-  for (const auto& tip : truth) {
-    if (tip) {
-      out << ',' << tip->x() << ',' << tip->y() << ',' << tip->z();
+// One row: the estimate's points, then the truth's (truth(k): point k, if annotated).
+template <typename Estimated, typename Truth>
+void write_points_row(std::ostream& out, const std::string& sequence, size_t frame, double time_s, TrackingState state,
+                      const Estimated& estimated, size_t count, const Truth& truth) {
+  out << sequence << ',' << frame << ',' << time_s << ',' << static_cast<int>(state);
+  for (size_t k = 0; k < count; ++k) out << ',' << estimated[k].x() << ',' << estimated[k].y() << ',' << estimated[k].z();
+  for (size_t k = 0; k < count; ++k) {
+    if (const std::optional<Eigen::Vector3d> p = truth(k)) {
+      out << ',' << p->x() << ',' << p->y() << ',' << p->z();
     } else {
       out << ",,,";
     }
   }
   out << '\n';
+}
+
+// The rows of one frame and hand for --tips-csv and --joints-csv (whichever are asked for).
+void write_frame_rows(std::ostream* tips, std::ostream* joints, const std::string& sequence, size_t frame,
+                      double time_s, const TrackerOutput& estimate, const Fingertips& true_tips,
+                      const std::optional<Joints>& true_joints) {
+  if (tips != nullptr) {
+    write_points_row(*tips, sequence, frame, time_s, estimate.state, estimate.fingertips, kNumFingers,
+                     [&](size_t k) { return true_tips[k]; });
+  }
+  if (joints != nullptr) {
+    write_points_row(*joints, sequence, frame, time_s, estimate.state, estimate.joints, kNumJoints,
+                     [&](size_t k) -> std::optional<Eigen::Vector3d> {
+                       if (!true_joints) return std::nullopt;
+                       return (*true_joints)[k];
+                     });
+  }
 }
 
 // The progress over all sequences' frames, which the --jobs workers share.
@@ -127,6 +163,7 @@ struct FrameLoop {
   const PixelLabeller* labeller = nullptr;
   std::vector<uint8_t>* oracle_labels = nullptr;  // non-null: filled with each frame's labels/
   std::ostream* tips = nullptr;                   // non-null: --tips-csv
+  std::ostream* joints = nullptr;                 // non-null: --joints-csv
   SharedProgress* progress = nullptr;
 
   // Tracks every frame of `reader` with track(depth) (timed) and hands its output to
@@ -145,7 +182,7 @@ struct FrameLoop {
     }
     return seconds;
   }
-  [[nodiscard]] bool writes_tips() const { return tips != nullptr; }
+  [[nodiscard]] bool writes_points() const { return tips != nullptr || joints != nullptr; }
 };
 
 // One hand (SPEC.md): HandsTracker with room for one, scored by SequenceScorer.
@@ -165,8 +202,9 @@ eval::SequenceScore evaluate_one_hand(const SequenceReader& reader, const Sequen
       reader, track,
       [&](size_t i, const TrackerOutput& out) {
         scorer.add(out, reader.fingertips(i), reader.joints(i));
-        if (loop.writes_tips()) {
-          write_tips_row(*loop.tips, name, i, static_cast<double>(i) / reader.camera().fps, out, reader.fingertips(i));
+        if (loop.writes_points()) {
+          write_frame_rows(loop.tips, loop.joints, name, i, static_cast<double>(i) / reader.camera().fps, out,
+                           reader.fingertips(i), reader.joints(i));
         }
       });
   return scorer.finish(seconds);
@@ -192,11 +230,12 @@ eval::SequenceScore evaluate_hands(const SequenceReader& reader, const SequenceI
         }
         const std::span<const TrackerOutput> tracked(out.hands.data(), static_cast<size_t>(out.count));
         const eval::HandMatch match = scorer.add(tracked, truth, joints);
-        if (!loop.writes_tips()) return;
+        if (!loop.writes_points()) return;
         for (size_t k = 0; k < truth.size(); ++k) {
           const int t = match.tracked_of_truth[k];
-          write_tips_row(*loop.tips, name + "/h" + std::to_string(k), i, static_cast<double>(i) / reader.camera().fps,
-                         t >= 0 ? tracked[static_cast<size_t>(t)] : TrackerOutput{}, truth[k]);
+          write_frame_rows(loop.tips, loop.joints, name + "/h" + std::to_string(k), i,
+                           static_cast<double>(i) / reader.camera().fps,
+                           t >= 0 ? tracked[static_cast<size_t>(t)] : TrackerOutput{}, truth[k], joints[k]);
         }
       });
   return scorer.finish(seconds);
@@ -212,6 +251,7 @@ int main(int argc, char** argv) {
   std::string plot_file;
   std::string csv_file;
   std::string tips_file;
+  std::string joints_file;
   std::string hand = "auto";
   std::string energy = "late-fusion";
   TrackerConfig config;
@@ -224,6 +264,9 @@ int main(int argc, char** argv) {
   app.add_option("--tips-csv", tips_file,
                  "write per-frame fingertips as CSV: sequence,frame,time_s,state, 15 estimated and 15 true "
                  "coordinates (mm; empty where not annotated); what scripts/filter-table smooths");
+  app.add_option("--joints-csv", joints_file,
+                 "write per-frame joints as CSV: sequence,frame,time_s,state, the 21 joints estimated and true "
+                 "(est_wrist_x ... true_little_tip_z, mm; empty where the sequence has no joints.csv)");
   tools::add_hand_option(app, hand);
   std::string arrangement = "facing";
   tools::add_arrangement_option(app, arrangement);
@@ -338,16 +381,21 @@ int main(int argc, char** argv) {
       }
       total_frames += readers.back().frame_count();
     }
+    // The point files, opened (and refused with one line) before anything is tracked.
     std::ofstream tips_out;
-    if (!tips_file.empty()) {
-      tips_out.open(tips_file);
-      if (!tips_out) throw std::runtime_error(tips_file + ": cannot write");
-      write_tips_header(tips_out);
+    std::ofstream joints_out;
+    for (const auto& [file, out, columns] : {std::tuple{&tips_file, &tips_out, PointColumns::fingertips()},
+                                             std::tuple{&joints_file, &joints_out, PointColumns::joints()}}) {
+      if (file->empty()) continue;
+      out->open(*file);
+      if (!*out) throw std::runtime_error(*file + ": cannot write");
+      columns.write_header(*out);
     }
     // --jobs: workers take the sequences in turn, each tracked from its first frame by a tracker of
     // its own, so every score is what one job gives; the results are gathered in the given order.
     std::vector<eval::SequenceScore> scores(readers.size());
     std::vector<std::string> tips_rows(readers.size());
+    std::vector<std::string> joints_rows(readers.size());
     std::vector<std::exception_ptr> failures(readers.size());
     SharedProgress progress(total_frames);
     std::atomic<size_t> next_sequence{0};
@@ -361,7 +409,9 @@ int main(int argc, char** argv) {
       loop.progress = &progress;
       for (size_t i = next_sequence++; i < readers.size(); i = next_sequence++) {
         std::ostringstream tips;
+        std::ostringstream joints;
         loop.tips = tips_file.empty() ? nullptr : &tips;
+        loop.joints = joints_file.empty() ? nullptr : &joints;
         try {
           const SequenceInfo info = read_sequence_info(readers[i]);
           scores[i] = readers[i].hand_count() > 1 || hands_asked
@@ -374,6 +424,7 @@ int main(int argc, char** argv) {
           next_sequence = readers.size();  // the run fails: no worker starts another sequence
         }
         tips_rows[i] = std::move(tips).str();
+        joints_rows[i] = std::move(joints).str();
       }
     };
     {
@@ -385,6 +436,7 @@ int main(int argc, char** argv) {
       if (failure) std::rethrow_exception(failure);
     }
     for (const auto& rows : tips_rows) tips_out << rows;
+    for (const auto& rows : joints_rows) joints_out << rows;
     const auto total = eval::overall(scores);
     // A mean over no frame is not a result: every annotated frame got no pose (or a NaN one). Nor is
     // a handedness over no frame, where nothing is annotated.
