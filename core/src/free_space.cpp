@@ -80,18 +80,31 @@ void FreeSpaceMap::build(const CameraIntrinsics& camera, const std::vector<float
   for (int v = 0; v < h; ++v) {
     const uint8_t* mask = hand_mask.data() + static_cast<size_t>(v) * w;
     const float* depth = depth_mm.data() + static_cast<size_t>(v) * w;
-    // Most rows hold no hand: find its first pixel (memchr-fast) before looking at depths.
+    // Most rows hold no hand: find its first and last pixels (memchr-fast) before looking at depths.
     const auto* first = static_cast<const uint8_t*>(std::memchr(mask, 1, static_cast<size_t>(w)));
     if (first == nullptr) continue;
-    for (int u = static_cast<int>(first - mask); u < w; ++u) {
-      if (mask[u] == 0 || !(depth[u] > 0.0F)) continue;
-      u_lo = std::min(u_lo, u);
-      u_hi = std::max(u_hi, u);
-      v_lo = std::min(v_lo, v);
-      v_hi = std::max(v_hi, v);
-      near_mm = std::min(near_mm, depth[u]);
-      far_mm = std::max(far_mm, depth[u]);
+    const auto* last = static_cast<const uint8_t*>(memrchr(mask, 1, static_cast<size_t>(w)));
+    const auto seen = [&](int u) { return mask[u] != 0 && depth[u] > 0.0F; };
+    // The depth range of the row's hand pixels with a depth (branch-free: vectorised) ...
+    float row_near = kFar;
+    float row_far = 0.0F;
+#pragma omp simd reduction(min : row_near) reduction(max : row_far)
+    for (int u = static_cast<int>(first - mask); u <= static_cast<int>(last - mask); ++u) {
+      row_near = std::min(row_near, seen(u) ? depth[u] : kFar);
+      row_far = std::max(row_far, seen(u) ? depth[u] : 0.0F);
     }
+    if (row_far == 0.0F) continue;  // none has a depth
+    // ... and the first and last of them.
+    int u_first = static_cast<int>(first - mask);
+    while (!seen(u_first)) ++u_first;
+    int u_last = static_cast<int>(last - mask);
+    while (!seen(u_last)) --u_last;
+    u_lo = std::min(u_lo, u_first);
+    u_hi = std::max(u_hi, u_last);
+    v_lo = std::min(v_lo, v);
+    v_hi = std::max(v_hi, v);
+    near_mm = std::min(near_mm, row_near);
+    far_mm = std::max(far_mm, row_far);
   }
   if (u_hi < 0) return;
   // The cap in pixels where it is largest, at the hand's nearest depth; the box reaches that far
@@ -115,14 +128,23 @@ void FreeSpaceMap::build(const CameraIntrinsics& camera, const std::vector<float
   // A cell is free (infinity) where all its pixels are free, not free (0) where any one is; pixels
   // beyond the image are not free.
   const float free_beyond_mm = far_mm + static_cast<float>(config.margin_mm);
+  const auto not_free = [free_beyond_mm](float d) { return d > 0.0F && d <= free_beyond_mm; };
+  // The cells whose pixels all lie in the image, [x_in, x_out) (the box starts at an even pixel,
+  // -2 at the least), and the image's last column where it is the first of a cell (an odd width).
+  const int x_in = std::max(0, -u0_ / kCellPx);
+  const int x_out = std::clamp((w - u0_) / kCellPx, x_in, width_);
+  const bool odd_column = x_out < width_ && u0_ + kCellPx * x_out == w - 1;
   std::fill(scratch_.begin(), scratch_.end(), kFar);
   for (int v = std::max(0, v0_); v < std::min(h, v0_ + height_ * kCellPx); ++v) {
     float* out = scratch_.data() + static_cast<size_t>((v - v0_) / kCellPx) * width_;
     const float* depth = depth_mm.data() + static_cast<size_t>(v) * w;
-    for (int u = std::max(0, u0_); u < std::min(w, u0_ + width_ * kCellPx); ++u) {
-      const float d = depth[u];
-      if (d > 0.0F && d <= free_beyond_mm) out[(u - u0_) / kCellPx] = 0.0F;
+    static_assert(kCellPx == 2, "the loop below reads a cell's two pixels of the row");
+    for (int x = x_in; x < x_out; ++x) {  // branch-free: vectorised
+      const int u = u0_ + kCellPx * x;
+      const bool any = not_free(depth[u]) | not_free(depth[u + 1]);
+      out[x] = any ? 0.0F : out[x];
     }
+    if (odd_column && not_free(depth[w - 1])) out[x_out] = 0.0F;
   }
   // The box's first or last column (row) of cells reaches beyond the image where it has a pixel
   // outside it.

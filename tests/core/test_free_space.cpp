@@ -1,5 +1,6 @@
 // FreeSpaceMap (E_free's distances): Euclidean distances to the nearest pixel where the hand can be
-// (within three quarters of a pixel of the exact ones: the map is held in cells of 2 x 2 pixels), what
+// (within three quarters of a pixel of the exact ones where whole cells of 2 x 2 pixels are not
+// free: the map is held in such cells), what
 // counts as free space, the image's edge, the cap, and the bilinear sample.
 #include "handtrack/core/free_space.hpp"
 
@@ -14,15 +15,24 @@ namespace handtrack {
 namespace {
 
 constexpr float kHandMm = 400.0F;
-// The map's cells are 2 x 2 pixels: its distances are within this of the exact ones.
+// The map's cells are 2 x 2 pixels: its distances are within this of the exact ones where the
+// pixels that are not free fill whole cells, away from creases ...
 constexpr double kCellTolerancePx = 0.75;
+// ... and within a pixel on a crease, where the nearest pixel that is not free changes from one
+// region to another and the bilinear sample between cell centres (2 px apart) cuts the ridge.
+constexpr double kCreaseTolerancePx = 1.0;
 
 // A 320x240 scene: a wall at 700 mm (free: far behind the hand), a 30x40 px hand at 400 mm.
 struct Scene {
   CameraIntrinsics camera;
   std::vector<float> depth;
   std::vector<uint8_t> mask;
-  Scene() : depth(static_cast<size_t>(camera.width * camera.height), 700.0F), mask(depth.size(), 0) {}
+  explicit Scene(int width = 320, int height = 240) {
+    camera.width = width;
+    camera.height = height;
+    depth.assign(static_cast<size_t>(width) * static_cast<size_t>(height), 700.0F);
+    mask.assign(depth.size(), 0);
+  }
   void fill(int u0, int v0, int u1, int v1, float mm, bool hand) {
     for (int v = v0; v < v1; ++v) {
       for (int u = u0; u < u1; ++u) {
@@ -99,6 +109,52 @@ TEST(FreeSpaceMap, ASurfaceJustBehindTheHandIsNotFreeAndTheImageEdgeIsNot) {
   EXPECT_NEAR(map.at(0, 90), 1.0, kCellTolerancePx) << "the pixel beyond the image's edge is not free";
   EXPECT_NEAR(map.at(5, 90), 6.0, kCellTolerancePx);
   EXPECT_NEAR(map.at(5, 160), 6.0, kCellTolerancePx) << "nor is the rest of the image's edge";
+}
+
+// An odd width and height: the cells are marked two pixels at a time, and the last column and row
+// share their cells with pixels beyond the image (a bezel in front of the scene, at the edge, is
+// not free, and whole cells are marked for it).
+TEST(FreeSpaceMap, AnOddImageSizeIsMarkedUpToItsLastColumnAndRow) {
+  Scene scene(321, 241);
+  scene.fill(320, 0, 321, 241, 300.0F, false);  // the bezel
+  scene.fill(0, 240, 321, 241, 300.0F, false);
+  scene.fill(270, 190, 300, 226, kHandMm, true);
+  scene.fill(302, 166, 306, 186, 300.0F, false);  // an occluder over whole cells
+  const FreeSpaceConfig config;
+  FreeSpaceMap map;
+  map.build(scene.camera, scene.depth, scene.mask, config);
+  ASSERT_FALSE(map.empty());
+  const auto margin = static_cast<float>(config.margin_mm);
+  // The map's box: the cap around the hand, here to the image's edge.
+  const int reach = static_cast<int>(map.cap_px());
+  double error_sum = 0.0;
+  int checked = 0;
+  for (int v = 190 - reach; v < 241; ++v) {
+    for (int u = 270 - reach; u < 321; ++u) {
+      const double expected = scene.brute_distance(u, v, map.cap_px(), margin);
+      ASSERT_NEAR(map.at(u, v), expected, kCreaseTolerancePx) << "pixel " << u << "," << v;
+      error_sum += std::abs(map.at(u, v) - expected);
+      ++checked;
+    }
+  }
+  EXPECT_LT(error_sum / checked, 0.2) << "mean error (px)";
+  EXPECT_EQ(map.at(304, 175), 0.0) << "the occluder";
+  EXPECT_NEAR(map.at(314, 175), 6.0, kCellTolerancePx) << "beside the bezel";
+}
+
+// A cell is not free where either of its two pixels in a row is not: a lone pixel makes its whole
+// cell not free, as the first or the second of the cell's columns.
+TEST(FreeSpaceMap, ALonePixelMakesItsCellNotFree) {
+  for (const int u : {250, 251}) {
+    Scene scene;
+    scene.fill(200, 100, 230, 140, kHandMm, true);
+    scene.fill(u, 120, u + 1, 121, kHandMm, false);
+    FreeSpaceMap map;
+    map.build(scene.camera, scene.depth, scene.mask);
+    // The cell's centre (pixels 250-251, 120-121), where the bilinear sample is the cell's own.
+    EXPECT_EQ(map.sample(250.5, 120.5).distance_px, 0.0) << "lone pixel at " << u;
+    EXPECT_NEAR(map.at(251, 110), 10.0, kCellTolerancePx) << "lone pixel at " << u;
+  }
 }
 
 TEST(FreeSpaceMap, SampleIsContinuousWithItsGradient) {

@@ -3,7 +3,7 @@
 // behind the hand) and eight poses per frame near and off the true pose (energy_cases.hpp).
 //
 //   preprocessing   DepthInputBuilder::build without and with the part forest, the forest alone,
-//                   E_unseen's weights of a frame
+//                   E_free's map and E_unseen's weights of a frame
 //   E_sim           energy + gradient per factor, the optimised term and the plain reference
 //   E               PoseEnergy::evaluate (posing the model, every term, the chain rule)
 //   E_hand          the two-hand collision term alone, and E with another hand touching or apart
@@ -15,6 +15,7 @@
 #include "reference_energy.hpp"
 
 #include "handtrack/core/energy.hpp"
+#include "handtrack/core/free_space.hpp"
 #include "handtrack/core/optimizer.hpp"
 #include "handtrack/core/part_forest.hpp"
 
@@ -102,6 +103,20 @@ void BM_ForestLabels(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_ForestLabels)->Unit(benchmark::kMicrosecond);
+
+// E_free's map of one frame (free_space.hpp): the hand's box and depth range, the cells marked
+// free or not, the distance transform. Part of BM_Preprocess.
+void BM_FreeSpaceMap(benchmark::State& state) {
+  FreeSpaceMap map;
+  size_t i = 0;
+  for (auto _ : state) {
+    const testing::EnergyCase& c = cases()[i];
+    map.build(c.input.camera, c.frame.depth.depth_mm, c.input.hand_mask);
+    benchmark::DoNotOptimize(map.cap_px());
+    i = (i + 1) % cases().size();
+  }
+}
+BENCHMARK(BM_FreeSpaceMap)->Unit(benchmark::kMicrosecond);
 
 // E_unseen's weights of one frame (unseen_fingers.hpp): the label histogram of the whole image
 // (the frames' ground-truth labels) and the previous pose's rotation, once a frame while late
