@@ -30,7 +30,7 @@ void PreprocessStage::step(Frame& f) {
   watch_.busy(Stage::kPreprocess, f.seq, f.preprocess_start_ns);
   apply_reload();
   if (f.inputs_generation != input_generation_) {
-    f.inputs = HandsInputs(input_config_);  // SIGHUP only: allocates
+    f.inputs = HandsInputs(input_config_, splitter_);  // SIGHUP only: allocates
     f.inputs_generation = input_generation_;
   }
   f.has_input = false;

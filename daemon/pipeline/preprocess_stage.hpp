@@ -33,8 +33,9 @@ class PreprocessStage {
                   const PartForest* forest, PipelineTally& tally, StageWatch& watch, bool side = false,
                   std::function<void()> side_setup = {});
 
-  // Inputs for a new pool frame, for the configuration in force.
-  [[nodiscard]] HandsInputs make_inputs() const { return HandsInputs(input_config_); }
+  // Inputs for a new pool frame, for the configuration in force. They borrow the stage's splitter
+  // (they are shared out one at a time, in step()), so the stage must outlive them.
+  [[nodiscard]] HandsInputs make_inputs() { return HandsInputs(input_config_, splitter_); }
   void step(Frame& frame);
 
  private:
@@ -46,6 +47,7 @@ class PreprocessStage {
   PipelineTally& tally_;
   StageWatch& watch_;
   DepthInputConfig input_config_;
+  FrameSplitter splitter_;  // every pool frame's: only step() shares a frame out
   uint64_t input_generation_ = 0;
   int stream_width_ = 0;
   int stream_height_ = 0;

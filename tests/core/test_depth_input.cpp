@@ -458,6 +458,38 @@ TEST(HandsInputs, ANewHandIsNotABody) {
   }
 }
 
+// HandsInputs that borrow one FrameSplitter (handtrackd's pool of frames): a frame's inputs are
+// what HandsInputs of its own give, and stay so when another frame is shared out with the same
+// splitter (nothing of a built frame lives in the splitter).
+TEST(HandsInputs, ThoseBorrowingOneSplitterKeepTheirOwnFrame) {
+  const auto cam = camera(320, 240);
+  std::vector<uint8_t> part;
+  const DepthImage with_body = body_scene(cam, -220.0, false, part);
+  const DepthImage blob = blob_scene(cam, 450, false);
+  HandsRequest request;
+  request.max_hands = 2;
+  HandsInputs own;
+  own.build(with_body, request);
+  ASSERT_TRUE(own.has(0));
+  const DepthInput& expected = *own.slot(0).get(Handedness::kRight);
+  FrameSplitter splitter;
+  HandsInputs first(DepthInputConfig{}, splitter);
+  HandsInputs second(DepthInputConfig{}, splitter);
+  first.build(with_body, request);
+  second.build(blob, request);  // the next frame, another scene
+  ASSERT_TRUE(first.has(0));
+  const DepthInput& kept = *first.slot(0).get(Handedness::kRight);
+  EXPECT_TRUE(kept.hand_mask == expected.hand_mask);
+  EXPECT_TRUE(kept.filtered_mm == expected.filtered_mm);
+  ASSERT_EQ(kept.gaussians.size(), expected.gaussians.size());
+  for (size_t i = 0; i < kept.gaussians.size(); ++i) {
+    EXPECT_EQ(kept.gaussians[i].depth_mm, expected.gaussians[i].depth_mm) << "leaf " << i;
+  }
+  EXPECT_LT((*first.candidate(0) - *own.candidate(0)).norm(), 1e-9);
+  ASSERT_TRUE(second.has(0));
+  EXPECT_FALSE(second.slot(0).get(Handedness::kRight)->filtered_mm == kept.filtered_mm) << "the scenes differ";
+}
+
 TEST(DepthInput, AShareOfTheFrameSegmentedAfreshIsItsLargestSurface) {
   // Touching hands are split pixel by pixel, which can leave a slot a sliver of the other hand
   // nearer the camera than its own (two_clap, docs/TRACKER.md "Two hands"). Segmented afresh (a

@@ -348,12 +348,23 @@ bool any_starts(const std::vector<NotifyListener::Message>& m, const std::string
   });
 }
 
+// The daemon runs 3.5 s from READY=1. Timed from its start instead, the test failed once in the
+// suite (2026-11-30, not seen again in 14 runs beside CPU hogs and the mutants test; which
+// expectation failed was not kept): under load the start, the forest loaded and the pool
+// allocated, eats into those seconds, and it is not what the watchdog is about. The daemon's log
+// now goes with each expectation.
 TEST_F(Handtrackd, NotifiesReadyStatusAndWatchdogWhileProgressing) {
   ShmName shm("notify");
   NotifyListener listener(dir_ / "notify.sock");
   Child d(daemon_args({"--source", "synthetic:pinch", "--shm-name", shm.str()}), dir_ / "d.out", dir_ / "d.err",
           {listener.env(), "WATCHDOG_USEC=1000000"});
-  std::this_thread::sleep_for(3500ms);
+  const auto give_up = Clock::now() + 30s;
+  std::vector<Clock::time_point> ready;
+  while ((ready = times_of(listener.messages(), "READY=1")).empty() && Clock::now() < give_up) {
+    std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_FALSE(ready.empty()) << "no READY=1 within 30 s\n" << d.err();
+  std::this_thread::sleep_until(ready.front() + 3500ms);
   const auto end = Clock::now();
   d.signal(SIGTERM);
   ASSERT_EQ(d.wait(10s), 0) << d.err();
@@ -363,10 +374,10 @@ TEST_F(Handtrackd, NotifiesReadyStatusAndWatchdogWhileProgressing) {
   EXPECT_TRUE(any_starts(m, "STATUS=", "fps")) << "no STATUS= with the frame rate";
   EXPECT_TRUE(any_starts(m, "STOPPING=1"));
   const auto pings = times_of(m, "WATCHDOG=1");
-  // WatchdogSec = 1 s: a ping every 0.5 s while the pipeline makes progress.
-  EXPECT_GE(pings.size(), 5U);
+  // WatchdogSec = 1 s: a ping every 0.5 s while the pipeline makes progress (7 in 3.5 s).
+  EXPECT_GE(pings.size(), 5U) << d.err();
   ASSERT_FALSE(pings.empty());
-  EXPECT_LT(end - pings.back(), 1200ms) << "pings stopped although the pipeline was progressing";
+  EXPECT_LT(end - pings.back(), 1200ms) << "pings stopped although the pipeline was progressing\n" << d.err();
 }
 
 TEST_F(Handtrackd, WatchdogPingsStopWhenTheSourceHangs) {
