@@ -17,11 +17,11 @@ static_assert(kMaxHands == 2, "HandsInputs::inputs_ lists one TrackerInputs per 
 HandsInputs::HandsInputs(const DepthInputConfig& config)
     : config_(config),
       own_splitter_(std::make_unique<FrameSplitter>()),
-      splitter_(own_splitter_.get()),
+      splitter_(own_splitter_->splitter_.get()),
       inputs_{TrackerInputs(config), TrackerInputs(config)} {}
 
 HandsInputs::HandsInputs(const DepthInputConfig& config, FrameSplitter& splitter)
-    : config_(config), splitter_(&splitter), inputs_{TrackerInputs(config), TrackerInputs(config)} {}
+    : config_(config), splitter_(splitter.splitter_.get()), inputs_{TrackerInputs(config), TrackerInputs(config)} {}
 
 HandsInputs::~HandsInputs() = default;
 HandsInputs::HandsInputs(HandsInputs&&) noexcept = default;
@@ -39,7 +39,7 @@ uint32_t HandsInputs::share(const DepthImage& depth, const HandsRequest& request
   // something else sizeable is in the volume (a body, its head), the whole frame when not (then
   // exactly as a Tracker alone sees it), and a free slot is not given a surface found to be no hand
   // again and again (HandsRequest::rejected).
-  splitter_->splitter_->split(config_, depth, request, foreign_, share_, candidate_);
+  splitter_->split(config_, depth, request, foreign_, share_, candidate_);
   uint32_t slots = 0;
   for (size_t s = 0; s < kMaxHands; ++s) {
     has_[s] = share_[s] != FrameShare::kNothing;
@@ -53,7 +53,7 @@ void HandsInputs::build_slot(int slot, const DepthImage& depth, const HandsReque
   const auto s = static_cast<size_t>(slot);
   // The splitter's median filter is every slot's.
   inputs_[s].build(depth, request.slots[s].request, labeller, share_[s] == FrameShare::kWhole ? nullptr : &foreign_[s],
-                   &splitter_->splitter_->median());
+                   &splitter_->median());
 }
 
 HandsTracker::HandsTracker(const TrackerConfig& config)

@@ -349,8 +349,8 @@ bool any_starts(const std::vector<NotifyListener::Message>& m, const std::string
 }
 
 // The daemon runs 3.5 s from READY=1. Timed from its start instead, the test failed once in the
-// suite (2026-11-30, not seen again in 14 runs beside CPU hogs and the mutants test; which
-// expectation failed was not kept): under load the start, the forest loaded and the pool
+// suite (2026-11-30; not seen again in the runs since, alone, beside CPU hogs and beside the
+// mutants test; which expectation failed was not kept): under load the start, the forest loaded and the pool
 // allocated, eats into those seconds, and it is not what the watchdog is about. The daemon's log
 // now goes with each expectation.
 TEST_F(Handtrackd, NotifiesReadyStatusAndWatchdogWhileProgressing) {

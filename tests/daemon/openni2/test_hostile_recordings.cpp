@@ -71,7 +71,7 @@ struct PlayResult {
 // not the tracker nor the pipeline: the tracker runs depth-only (loading the 26 MB part forest was
 // half of each run) and the pipeline holds 4 frames (the default's 14 frames of 640x480 buffers,
 // touched for the first time as the recording's 24 frames pass, were half of what was left: 0.55
-// -> 0.29 s a play, 117 -> 41 MB).
+// -> 0.29 s a play).
 PlayResult play(const fs::path& file, const TempDir& dir, const std::string& shm) {
   const fs::path config = dir / "small.toml";
   if (!fs::exists(config)) {

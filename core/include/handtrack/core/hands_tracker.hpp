@@ -76,7 +76,7 @@ enum class FrameShare : uint8_t {
 // surfaces and their claims, a few full-frame buffers), needed from HandsInputs::share() until the
 // frame's slots are built. A HandsInputs owns one, or borrows one that several share: handtrackd's
 // pool of frames is shared out one frame at a time, so one serves them all (640x480 depth: the
-// daemon's resident memory 117 -> 54 MB).
+// daemon's resident memory 117 -> 53 MB).
 class FrameSplitter {
  public:
   FrameSplitter();
@@ -119,7 +119,7 @@ class HandsInputs {
  private:
   DepthInputConfig config_;
   std::unique_ptr<FrameSplitter> own_splitter_;  // null when borrowed
-  FrameSplitter* splitter_;
+  HandSplitter* splitter_;                       // own_splitter_'s or the borrowed one's
   std::array<std::vector<uint8_t>, kMaxHands> foreign_{};  // kOwn slots: 1 = not the slot's pixel
   std::array<TrackerInputs, kMaxHands> inputs_;
   std::array<bool, kMaxHands> has_{};
