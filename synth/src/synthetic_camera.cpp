@@ -182,6 +182,16 @@ CameraIntrinsics default_camera(int width, int height) {
   return c;
 }
 
+CameraIntrinsics camera_with_fov(int width, int height, double horizontal_fov_deg) {
+  if (!(horizontal_fov_deg >= 20.0 && horizontal_fov_deg <= 150.0)) {
+    throw std::invalid_argument("field of view must be within [20, 150] deg, got " + std::to_string(horizontal_fov_deg));
+  }
+  CameraIntrinsics c = default_camera(width, height);
+  c.fx = 0.5 * width / std::tan(0.5 * horizontal_fov_deg * M_PI / 180.0);
+  c.fy = c.fx * (SpecCamera::kFy / SpecCamera::kFx);
+  return c;
+}
+
 struct SyntheticCamera::State {
   SynthOptions options;
   std::array<HandShape, kTwoHands> shapes;  // [1]: two-hand motions only

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -83,6 +84,7 @@ TEST_F(SynthCli, BadArgumentsGiveOneClearLine) {
   expect_one_line_error("--motion pinch --frames 5 --subject-scale 3,1 " + out, "--subject-scale");
   expect_one_line_error("--motion pinch --frames 5 --subject-scale 1.0 " + out, "--subject-scale");
   expect_one_line_error("--motion pinch --frames 5 --width 0 " + out, "--width");
+  expect_one_line_error("--motion pinch --frames 5 --fov 170 " + out, "--fov");
   expect_one_line_error("--motion pinch --frames 5", "--out");
   expect_one_line_error("--frames 5 " + out, "--motion");
   expect_one_line_error("--motion pinch --bogus " + out, "bogus");
@@ -160,6 +162,32 @@ TEST_F(SynthCli, Writes640x480SequenceWithConsistentGroundTruth) {
   const RunResult forced = run(again + " --force --no-noise --background none");
   EXPECT_EQ(forced.exit_code, 0) << forced.err;
   EXPECT_EQ(handtrack::SequenceReader(seq).frame_count(), 3u);
+}
+
+// --fov: another camera's lens. The focal lengths follow from the field of view, and the same
+// hand at the same place covers fewer pixels through a wider lens, by the square of the focal
+// lengths' ratio.
+TEST_F(SynthCli, AWiderFieldOfViewShowsTheSameHandSmaller) {
+  const std::string args = "--motion pinch --frames 1 --seed 3 --no-noise --background none ";
+  const fs::path spec = dir_ / "spec", wide = dir_ / "wide";
+  ASSERT_EQ(run(args + "--out '" + spec.string() + "'").exit_code, 0);
+  const RunResult r = run(args + "--fov 87 --out '" + wide.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const handtrack::SequenceReader a(spec);
+  const handtrack::SequenceReader b(wide);
+  const double fx = 160.0 / std::tan(43.5 * M_PI / 180.0);
+  EXPECT_NEAR(b.camera().fx, fx, 1e-6);
+  EXPECT_NEAR(b.camera().fy / b.camera().fx, a.camera().fy / a.camera().fx, 1e-9);
+  EXPECT_EQ(b.camera().width, 320);
+  const auto hand_pixels = [](const handtrack::SequenceReader& reader) {
+    const auto labels = reader.labels(0);
+    return labels ? std::count_if(labels->pixels.begin(), labels->pixels.end(), [](uint8_t l) { return l != 0; }) : 0;
+  };
+  const double ratio = static_cast<double>(hand_pixels(b)) / static_cast<double>(hand_pixels(a));
+  const double expected = (fx / a.camera().fx) * (fx / a.camera().fx);
+  EXPECT_NEAR(ratio, expected, 0.05) << hand_pixels(b) << " against " << hand_pixels(a) << " pixels";
+  // The tips are where the scene puts them, whatever the lens.
+  EXPECT_LT((*a.fingertips(0)[1] - *b.fingertips(0)[1]).norm(), 1e-6);
 }
 
 // --proportions varied: subject.json says so and gives each hand's proportions, which its bone

@@ -225,6 +225,11 @@ int main(int argc, char** argv) {
                                  "it places both hands itself)");
   app.add_option("--width", width, "Image width (intrinsics scale with it)")->check(CLI::Range(16, 4096));
   app.add_option("--height", height, "Image height (intrinsics scale with it)")->check(CLI::Range(16, 4096));
+  double fov_deg = 0.0;
+  app.add_option("--fov", fov_deg,
+                 "Horizontal field of view in degrees (default: the SPEC.md camera's 70.9; a Kinect's is about 58, a "
+                 "RealSense D435's 87)")
+      ->check(CLI::Range(20.0, 150.0));
   app.add_flag("--preview", preview, "Also write preview/NNNNNN.png (depth gray | labels in colour)");
   app.add_flag("--no-labels", no_labels, "Do not write labels/");
   app.add_flag("--force", force, "Replace a sequence already in --out");
@@ -277,7 +282,8 @@ int main(int argc, char** argv) {
     options.hand = *handedness;
     options.proportions = *shape_proportions;
     options.view = *arrangement;
-    options.camera = handtrack::synth::default_camera(width, height);
+    options.camera = app.count("--fov") > 0 ? handtrack::synth::camera_with_fov(width, height, fov_deg)
+                                            : handtrack::synth::default_camera(width, height);
     if (!subject.empty()) options.subject = parse_subject(subject);
     handtrack::synth::SyntheticCamera cam(options);
 

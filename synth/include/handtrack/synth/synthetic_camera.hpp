@@ -66,6 +66,11 @@ std::optional<Proportions> parse_proportions(std::string_view name);
 // 60 fps, 1 mm depth units) with the focal lengths scaled to width x height.
 CameraIntrinsics default_camera(int width = 320, int height = 240);
 
+// The SPEC.md camera with another horizontal field of view (the SPEC.md camera's: 70.9 deg; a
+// Kinect's about 58, a RealSense D435's 87): fx = (width / 2) / tan(fov / 2), fy in the SPEC.md
+// camera's proportion to fx. Throws std::invalid_argument outside [20, 150] deg.
+CameraIntrinsics camera_with_fov(int width, int height, double horizontal_fov_deg);
+
 struct SynthOptions {
   // One of kMotionNames, or of kTwoHandMotionNames: a right and a left hand (then `hand` must stay
   // kRight and `view` kPalm: the scene places both hands itself).
