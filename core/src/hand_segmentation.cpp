@@ -251,7 +251,7 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
     // The wrist sits about half a palm below the palm centre.
     wrist = centre - axis * (kWristBelowPalmCentre * length);
     count = select();
-    if (far_plane_cut_fraction(config, unclamped_mm, component_, best, w, h) > kMaxFarPlaneCut) count = 0;
+    if (reaches_in_through_far_plane(config, unclamped_mm, component_, best, w, h)) count = 0;
   }
   out.hand_pixels = count;
   out.finger_axis = axis;

@@ -208,7 +208,7 @@ void HandSplitter::split(const DepthInputConfig& config, const DepthImage& depth
     const Surface& s = surfaces_[c];
     if (owner_[c] != kNone || claims_[c].sampled == 0) continue;
     if (surface_area_mm2(cam, s.pixels, s.mean_depth()) < config.min_hand_area_mm2) continue;
-    if (far_plane_cut_fraction(config, median, component_, static_cast<int>(c), w, h) > kMaxFarPlaneCut) continue;
+    if (reaches_in_through_far_plane(config, median, component_, static_cast<int>(c), w, h)) continue;
     const Vector3d centroid = claims_[c].point_sum / claims_[c].sampled;
     bool rejected = false;
     for (int r = 0; r < request.rejected_count; ++r) {

@@ -34,15 +34,17 @@ void label_surfaces(const DepthInputConfig& config, const std::vector<float>& d,
   }
 }
 
-double far_plane_cut_fraction(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
-                              const std::vector<int>& component, int blob, int w, int h) {
+bool reaches_in_through_far_plane(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
+                                  const std::vector<int>& component, int blob, int w, int h) {
   const auto far = static_cast<float>(config.far_mm);
   const auto reach = static_cast<float>(config.far_mm + config.continuity_mm);
   int boundary = 0;
   int continued = 0;
+  float nearest = far;
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       if (component[static_cast<size_t>(v) * w + u] != blob) continue;
+      nearest = std::min(nearest, unclamped_mm[static_cast<size_t>(v) * w + u]);
       bool edge = false;
       bool beyond = false;
       for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
@@ -58,7 +60,8 @@ double far_plane_cut_fraction(const DepthInputConfig& config, const std::vector<
       continued += beyond ? 1 : 0;
     }
   }
-  return boundary > 0 ? static_cast<double>(continued) / boundary : 0.0;
+  const double cut = boundary > 0 ? static_cast<double>(continued) / boundary : 0.0;
+  return cut > kMaxFarPlaneCut && nearest > far - kMinHandReachMm;
 }
 
 }  // namespace handtrack

@@ -81,6 +81,7 @@ PlanePatch desk_under(const std::vector<ConeSphere>& primitives, View view) {
 }
 
 constexpr double kMaxBallRadiusMm = 100.0;
+constexpr double kMaxDepthOffsetMm = 250.0;
 // The palm's half thickness (its pieces' radii, hand_model.cpp): a held ball rests on its surface.
 constexpr double kPalmHalfThicknessMm = 13.5;
 
@@ -232,6 +233,12 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   if (!(options.ball_radius_mm >= 0.0 && options.ball_radius_mm <= kMaxBallRadiusMm)) {
     throw std::invalid_argument("ball radius must be within [0, 100] mm");
   }
+  if (!(std::abs(options.depth_offset_mm) <= kMaxDepthOffsetMm)) {
+    throw std::invalid_argument("depth offset must be within [-250, 250] mm");
+  }
+  if (is_two_hand_motion(options.motion) && options.depth_offset_mm != 0.0) {
+    throw std::invalid_argument("motion '" + options.motion + "': a depth offset is for one-hand motions");
+  }
   std::array<SubjectScale, kTwoHands> subjects;
   if (options.subject) {
     const auto ok = [](double s) { return std::isfinite(s) && s >= 0.5 && s <= 2.0; };
@@ -329,7 +336,13 @@ HandPose SyntheticCamera::pose(int frame, int hand) const {
   const State& s = *state_;
   (void)shape(hand);  // range check
   if (s.two_hands) return s.two_hands->pose(frame)[static_cast<size_t>(hand)];
-  return view_pose(s.options.view, s.motion->pose(frame), s.shapes[0]);
+  HandPose p = view_pose(s.options.view, s.motion->pose(frame), s.shapes[0]);
+  if (s.options.depth_offset_mm != 0.0) {
+    // Along the palm centre's ray: the hand keeps its place in the image and grows or shrinks.
+    const Vector3d palm = p.translation_mm + camera_R_hand(p.rotation) * s.shapes[0].palm_centre_mm;
+    p.translation_mm += palm * (s.options.depth_offset_mm / palm.z());
+  }
+  return p;
 }
 
 SynthFrame SyntheticCamera::render(int frame) {

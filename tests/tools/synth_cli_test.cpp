@@ -85,6 +85,8 @@ TEST_F(SynthCli, BadArgumentsGiveOneClearLine) {
   expect_one_line_error("--motion pinch --frames 5 --subject-scale 1.0 " + out, "--subject-scale");
   expect_one_line_error("--motion pinch --frames 5 --width 0 " + out, "--width");
   expect_one_line_error("--motion pinch --frames 5 --fov 170 " + out, "--fov");
+  expect_one_line_error("--motion pinch --frames 5 --depth-offset 400 " + out, "--depth-offset");
+  expect_one_line_error("--motion two_apart --frames 5 --depth-offset 50 " + out, "depth offset");
   expect_one_line_error("--motion pinch --frames 5", "--out");
   expect_one_line_error("--frames 5 " + out, "--motion");
   expect_one_line_error("--motion pinch --bogus " + out, "bogus");
@@ -188,6 +190,28 @@ TEST_F(SynthCli, AWiderFieldOfViewShowsTheSameHandSmaller) {
   EXPECT_NEAR(ratio, expected, 0.05) << hand_pixels(b) << " against " << hand_pixels(a) << " pixels";
   // The tips are where the scene puts them, whatever the lens.
   EXPECT_LT((*a.fingertips(0)[1] - *b.fingertips(0)[1]).norm(), 1e-6);
+}
+
+// --depth-offset: the whole hand moves along the ray through its palm centre, so every fingertip
+// moves by the same vector, whose depth is the offset, and the hand covers fewer pixels.
+TEST_F(SynthCli, ADepthOffsetMovesTheHandAlongItsRay) {
+  const std::string args = "--motion pinch --frames 1 --seed 3 --no-noise --background none ";
+  const fs::path there = dir_ / "there", farther = dir_ / "farther";
+  ASSERT_EQ(run(args + "--out '" + there.string() + "'").exit_code, 0);
+  const RunResult r = run(args + "--depth-offset 100 --out '" + farther.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const handtrack::SequenceReader a(there);
+  const handtrack::SequenceReader b(farther);
+  const auto tips_a = a.fingertips(0);
+  const auto tips_b = b.fingertips(0);
+  const Eigen::Vector3d moved = *tips_b[0] - *tips_a[0];
+  EXPECT_NEAR(moved.z(), 100.0, 0.01);
+  for (size_t f = 1; f < tips_a.size(); ++f) EXPECT_LT((*tips_b[f] - *tips_a[f] - moved).norm(), 0.01) << f;
+  const auto hand_pixels = [](const handtrack::SequenceReader& reader) {
+    const auto labels = reader.labels(0);
+    return labels ? std::count_if(labels->pixels.begin(), labels->pixels.end(), [](uint8_t l) { return l != 0; }) : 0;
+  };
+  EXPECT_LT(hand_pixels(b), hand_pixels(a) * 3 / 4);
 }
 
 // --proportions varied: subject.json says so and gives each hand's proportions, which its bone

@@ -225,6 +225,10 @@ int main(int argc, char** argv) {
                                  "it places both hands itself)");
   app.add_option("--width", width, "Image width (intrinsics scale with it)")->check(CLI::Range(16, 4096));
   app.add_option("--height", height, "Image height (intrinsics scale with it)")->check(CLI::Range(16, 4096));
+  app.add_option("--depth-offset", options.depth_offset_mm,
+                 "Move the hand this many mm along the ray through its palm centre in every frame: negative nearer "
+                 "the camera, positive farther (default 0: where the view puts it; one-hand motions)")
+      ->check(CLI::Range(-250.0, 250.0));
   double fov_deg = 0.0;
   app.add_option("--fov", fov_deg,
                  "Horizontal field of view in degrees (default: the SPEC.md camera's 70.9; a Kinect's is about 58, a "

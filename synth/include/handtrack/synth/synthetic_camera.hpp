@@ -91,6 +91,10 @@ struct SynthOptions {
   // > 0: a ball of this radius (mm, at most 100) held against the palm, moving with it (one-hand
   // motions); not the hand (label 0). The grasping motions close the fingers around it.
   double ball_radius_mm = 0.0;
+  // The hand moved this far along the ray through its palm centre in every frame: < 0 nearer the
+  // camera, > 0 farther (mm, within [-250, 250]; one-hand motions). The motion's own movement
+  // and the scene behind the hand stay as they are.
+  double depth_offset_mm = 0.0;
 };
 
 // The virtual camera as handtrackd's `synthetic[:MOTION]` source shows it: `frames` per pass of
