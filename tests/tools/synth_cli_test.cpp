@@ -16,6 +16,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #ifndef HANDTRACK_SYNTH_EXE
 #error "HANDTRACK_SYNTH_EXE must name the handtrack-synth binary"
@@ -36,6 +37,12 @@ std::string slurp(const fs::path& p) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// The pixels the first frame of `reader` labels as the hand.
+std::ptrdiff_t hand_pixels(const handtrack::SequenceReader& reader) {
+  const auto labels = reader.labels(0);
+  return labels ? std::count_if(labels->pixels.begin(), labels->pixels.end(), [](uint8_t l) { return l != 0; }) : 0;
 }
 
 class SynthCli : public ::testing::Test {
@@ -69,6 +76,17 @@ class SynthCli : public ::testing::Test {
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "stderr: " << r.err;
     EXPECT_NE(r.err.find(mentions), std::string::npos) << "stderr: " << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+
+  // One frame of a pinch, as rendered plainly and with the options `changed_by`: the two sequences.
+  std::pair<handtrack::SequenceReader, handtrack::SequenceReader> plain_and(const std::string& changed_by) const {
+    const std::string args = "--motion pinch --frames 1 --seed 3 --no-noise --background none ";
+    const fs::path plain = dir_ / "plain", changed = dir_ / "changed";
+    const RunResult a = run(args + "--out '" + plain.string() + "'");
+    EXPECT_EQ(a.exit_code, 0) << a.err;
+    const RunResult b = run(args + changed_by + " --out '" + changed.string() + "'");
+    EXPECT_EQ(b.exit_code, 0) << b.err;
+    return {handtrack::SequenceReader(plain), handtrack::SequenceReader(changed)};
   }
 
   fs::path dir_;
@@ -170,21 +188,11 @@ TEST_F(SynthCli, Writes640x480SequenceWithConsistentGroundTruth) {
 // hand at the same place covers fewer pixels through a wider lens, by the square of the focal
 // lengths' ratio.
 TEST_F(SynthCli, AWiderFieldOfViewShowsTheSameHandSmaller) {
-  const std::string args = "--motion pinch --frames 1 --seed 3 --no-noise --background none ";
-  const fs::path spec = dir_ / "spec", wide = dir_ / "wide";
-  ASSERT_EQ(run(args + "--out '" + spec.string() + "'").exit_code, 0);
-  const RunResult r = run(args + "--fov 87 --out '" + wide.string() + "'");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const handtrack::SequenceReader a(spec);
-  const handtrack::SequenceReader b(wide);
+  const auto [a, b] = plain_and("--fov 87");
   const double fx = 160.0 / std::tan(43.5 * M_PI / 180.0);
   EXPECT_NEAR(b.camera().fx, fx, 1e-6);
   EXPECT_NEAR(b.camera().fy / b.camera().fx, a.camera().fy / a.camera().fx, 1e-9);
   EXPECT_EQ(b.camera().width, 320);
-  const auto hand_pixels = [](const handtrack::SequenceReader& reader) {
-    const auto labels = reader.labels(0);
-    return labels ? std::count_if(labels->pixels.begin(), labels->pixels.end(), [](uint8_t l) { return l != 0; }) : 0;
-  };
   const double ratio = static_cast<double>(hand_pixels(b)) / static_cast<double>(hand_pixels(a));
   const double expected = (fx / a.camera().fx) * (fx / a.camera().fx);
   EXPECT_NEAR(ratio, expected, 0.05) << hand_pixels(b) << " against " << hand_pixels(a) << " pixels";
@@ -195,22 +203,12 @@ TEST_F(SynthCli, AWiderFieldOfViewShowsTheSameHandSmaller) {
 // --depth-offset: the whole hand moves along the ray through its palm centre, so every fingertip
 // moves by the same vector, whose depth is the offset, and the hand covers fewer pixels.
 TEST_F(SynthCli, ADepthOffsetMovesTheHandAlongItsRay) {
-  const std::string args = "--motion pinch --frames 1 --seed 3 --no-noise --background none ";
-  const fs::path there = dir_ / "there", farther = dir_ / "farther";
-  ASSERT_EQ(run(args + "--out '" + there.string() + "'").exit_code, 0);
-  const RunResult r = run(args + "--depth-offset 100 --out '" + farther.string() + "'");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const handtrack::SequenceReader a(there);
-  const handtrack::SequenceReader b(farther);
+  const auto [a, b] = plain_and("--depth-offset 100");
   const auto tips_a = a.fingertips(0);
   const auto tips_b = b.fingertips(0);
   const Eigen::Vector3d moved = *tips_b[0] - *tips_a[0];
   EXPECT_NEAR(moved.z(), 100.0, 0.01);
   for (size_t f = 1; f < tips_a.size(); ++f) EXPECT_LT((*tips_b[f] - *tips_a[f] - moved).norm(), 0.01) << f;
-  const auto hand_pixels = [](const handtrack::SequenceReader& reader) {
-    const auto labels = reader.labels(0);
-    return labels ? std::count_if(labels->pixels.begin(), labels->pixels.end(), [](uint8_t l) { return l != 0; }) : 0;
-  };
   EXPECT_LT(hand_pixels(b), hand_pixels(a) * 3 / 4);
 }
 
