@@ -203,6 +203,13 @@ void posed_primitives(const HandShape& shape, const HandPose& pose, const Joints
     forearm.b = forearm.a + (shape.forearm.b - shape.forearm.a).norm() * *shape.forearm_camera_direction;
   }
   out.push_back(forearm);
+  // The upper arm, a third thicker at the elbow than the forearm, as thick again at the shoulder.
+  constexpr double kUpperArmGirth = 1.3;
+  if (shape.upper_arm_camera_direction) {
+    const double r = kUpperArmGirth * forearm.radius_b;
+    out.push_back(
+        ConeSphere{forearm.b, forearm.b + shape.upper_arm_mm * *shape.upper_arm_camera_direction, r, r, kBackground});
+  }
 }
 
 void place_palm(HandPose& pose, const HandShape& shape, const Eigen::Matrix3d& turn, const Vector3d& palm_centre_mm) {

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <span>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace handtrack::synth {
@@ -59,7 +61,7 @@ constexpr double kDeskContactMm = 3.0;
 // Up from a table top toward a head-mounted camera (Background::kTable and the head-mounted desk).
 const Vector3d kTableUp = Vector3d(0.0, -1.0, -0.5).normalized();
 
-PlanePatch desk_under(const std::vector<ConeSphere>& primitives, View view) {
+PlanePatch desk_under(std::span<const ConeSphere> primitives, View view) {
   const bool forearm_on_desk = view == View::kPalm || view == View::kBack || view == View::kSide;
   // Into the desk.
   Vector3d down = view == View::kHeadMounted ? Vector3d(-kTableUp) : Vector3d(0.0, 0.3, 1.0);
@@ -239,6 +241,9 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   if (is_two_hand_motion(options.motion) && options.depth_offset_mm != 0.0) {
     throw std::invalid_argument("motion '" + options.motion + "': a depth offset is for one-hand motions");
   }
+  if (is_two_hand_motion(options.motion) && options.upper_arm) {
+    throw std::invalid_argument("motion '" + options.motion + "': the upper arm is for one-hand motions");
+  }
   std::array<SubjectScale, kTwoHands> subjects;
   if (options.subject) {
     const auto ok = [](double s) { return std::isfinite(s) && s >= 0.5 && s <= 2.0; };
@@ -272,8 +277,11 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   options.subject = subjects[0];  // hand 0's, as options() reports it
   // The arrangement holds the forearm (views.hpp view_shape): a two-hand scene's for both hands.
   const View arrangement = seen_in(options.motion, options.view);
-  const std::array<HandShape, kTwoHands> shapes{view_shape(arrangement, HandShape::for_subject(subjects[0])),
-                                                 view_shape(arrangement, HandShape::for_subject(subjects[1]))};
+  const auto shape_of = [&](const SubjectScale& subject) {
+    HandShape shape = view_shape(arrangement, HandShape::for_subject(subject));
+    return options.upper_arm ? with_upper_arm(arrangement, std::move(shape)) : shape;
+  };
+  const std::array<HandShape, kTwoHands> shapes{shape_of(subjects[0]), shape_of(subjects[1])};
   state_ = std::make_unique<State>(std::move(options), shapes);
   State& s = *state_;
   std::vector<PlanePatch> planes;
@@ -372,7 +380,11 @@ void SyntheticCamera::render_pose(const HandPose& pose, int frame, SynthFrame& o
   s.raycaster = s.background;  // same sizes: no allocation
   for (const auto& p : s.primitives) s.raycaster.draw(p);
   if (s.options.ball_radius_mm > 0.0) s.raycaster.draw(held_ball(shape, out.pose, s.options.ball_radius_mm));
-  if (s.options.background == Background::kDesk) s.raycaster.draw(desk_under(s.primitives, s.options.view));
+  if (s.options.background == Background::kDesk) {
+    // The hand and the forearm rest on it; the upper arm, posed last, rises from it to the shoulder.
+    const size_t resting = s.primitives.size() - (shape.upper_arm_camera_direction ? 1 : 0);
+    s.raycaster.draw(desk_under(std::span<const ConeSphere>(s.primitives.data(), resting), s.options.view));
+  }
   s.develop(frame, out);
   if (s.options.hand == Handedness::kLeft) mirror(out);
   out.hand_count = 1;

@@ -76,4 +76,11 @@ HandShape view_shape(View view, HandShape shape) {
   return shape;
 }
 
+HandShape with_upper_arm(View view, HandShape shape) {
+  if (view == View::kHeadMounted) return shape;
+  shape.upper_arm_camera_direction = Vector3d(-0.3, -0.5, 0.8).normalized();
+  shape.upper_arm_mm = 300.0 * shape.subject.length;
+  return shape;
+}
+
 }  // namespace handtrack::synth

@@ -105,6 +105,7 @@ TEST_F(SynthCli, BadArgumentsGiveOneClearLine) {
   expect_one_line_error("--motion pinch --frames 5 --fov 170 " + out, "--fov");
   expect_one_line_error("--motion pinch --frames 5 --depth-offset 400 " + out, "--depth-offset");
   expect_one_line_error("--motion two_apart --frames 5 --depth-offset 50 " + out, "depth offset");
+  expect_one_line_error("--motion two_apart --frames 5 --upper-arm " + out, "upper arm");
   expect_one_line_error("--motion pinch --frames 5", "--out");
   expect_one_line_error("--frames 5 " + out, "--motion");
   expect_one_line_error("--motion pinch --bogus " + out, "bogus");
@@ -210,6 +211,19 @@ TEST_F(SynthCli, ADepthOffsetMovesTheHandAlongItsRay) {
   EXPECT_NEAR(moved.z(), 100.0, 0.01);
   for (size_t f = 1; f < tips_a.size(); ++f) EXPECT_LT((*tips_b[f] - *tips_a[f] - moved).norm(), 0.01) << f;
   EXPECT_LT(hand_pixels(b), hand_pixels(a) * 3 / 4);
+}
+
+// --upper-arm: the arm goes on past the elbow, back to the shoulder: more of the image has depth,
+// none of it the hand's, some of it beyond the working volume (600 mm) as the arm reaches back.
+TEST_F(SynthCli, AnUpperArmGoesOnFromTheElbowToTheShoulder) {
+  const auto [a, b] = plain_and("--upper-arm");
+  const auto pixels = [](const handtrack::SequenceReader& reader, float beyond_mm) {
+    const auto depth = reader.depth(0).depth_mm;
+    return std::count_if(depth.begin(), depth.end(), [&](float d) { return d > beyond_mm; });
+  };
+  EXPECT_GT(pixels(b, 0.0F), pixels(a, 0.0F) + 1000);
+  EXPECT_GT(pixels(b, 600.0F), pixels(a, 600.0F) + 100);
+  EXPECT_EQ(hand_pixels(b), hand_pixels(a));
 }
 
 // --proportions varied: subject.json says so and gives each hand's proportions, which its bone

@@ -229,6 +229,9 @@ int main(int argc, char** argv) {
                  "Move the hand this many mm along the ray through its palm centre in every frame: negative nearer "
                  "the camera, positive farther (default 0: where the view puts it; one-hand motions)")
       ->check(CLI::Range(-250.0, 250.0));
+  app.add_flag("--upper-arm", options.upper_arm,
+               "Render the arm on past the elbow to the shoulder of a user facing the camera (desk views; "
+               "one-hand motions). Default: the forearm ends at the elbow");
   double fov_deg = 0.0;
   app.add_option("--fov", fov_deg,
                  "Horizontal field of view in degrees (default: the SPEC.md camera's 70.9; a Kinect's is about 58, a "

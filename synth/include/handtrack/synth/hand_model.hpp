@@ -104,6 +104,11 @@ struct HandShape {
   // unit direction of the camera frame, whatever the hand's rotation: the wrist bends, and the
   // elbow stays where the arrangement puts it (the head-mounted view: views.hpp, view_shape).
   std::optional<Eigen::Vector3d> forearm_camera_direction;
+  // When set, an upper arm (label 0) runs from the forearm's far end, the elbow, this far along
+  // this direction of the camera frame to the shoulder: a real arm does not end at the elbow
+  // (views.hpp, with_upper_arm).
+  std::optional<Eigen::Vector3d> upper_arm_camera_direction;
+  double upper_arm_mm = 0.0;
   Eigen::Vector3d palm_centre_mm = Eigen::Vector3d::Zero();  // hand frame; motions orbit around it
 
   // The mean adult right hand (scale 1.0) of the module brief.
@@ -121,7 +126,7 @@ Joints camera_frame_joints(const HandShape& shape, const HandPose& pose);
 Fingertips fingertips_from_joints(const Joints& joints);
 
 // All primitives of the posed hand in the camera frame: 15 phalanges (labels from part_label()),
-// the palm and the forearm. `out` is cleared and refilled (no allocation once it has grown).
+// the palm, the forearm and, where the shape has a shoulder, the upper arm. `out` is cleared and refilled (no allocation once it has grown).
 void posed_primitives(const HandShape& shape, const HandPose& pose, const Joints& camera_joints,
                       std::vector<ConeSphere>& out);
 

@@ -95,6 +95,10 @@ struct SynthOptions {
   // camera, > 0 farther (mm, within [-250, 250]; one-hand motions). The motion's own movement
   // and the scene behind the hand stay as they are.
   double depth_offset_mm = 0.0;
+  // The arm goes on past the elbow to the shoulder (views.hpp, with_upper_arm; one-hand motions).
+  // Off: the forearm ends in a rounded elbow, which a wide lens shows (docs/TRACKER.md, "Other
+  // cameras").
+  bool upper_arm = false;
 };
 
 // The virtual camera as handtrackd's `synthetic[:MOTION]` source shows it: `frames` per pass of

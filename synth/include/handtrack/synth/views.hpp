@@ -47,4 +47,10 @@ HandPose view_pose(View view, const HandPose& pose, const HandShape& shape);
 // whenever a motion rolls or tips the hand toward it, and cover the hand or the whole image.
 HandShape view_shape(View view, HandShape shape);
 
+// `shape` with an upper arm from its elbow back to the shoulder of a user facing a desk camera
+// (300 mm for the mean adult, with the subject's length; away from the camera, up and toward the
+// image's left, the right shoulder's side), where `view` is a desk view. A head-mounted camera's
+// elbow is below the camera and its upper arm behind it: unchanged.
+HandShape with_upper_arm(View view, HandShape shape);
+
 }  // namespace handtrack::synth
