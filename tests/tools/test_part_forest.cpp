@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -462,6 +463,37 @@ TEST(PartForestTraining, VariedFractionVariesTheHandsAndNothingElse) {
   }
   EXPECT_GT(varied, kScenes * 35 / 100);
   EXPECT_LT(varied, kScenes * 65 / 100);
+}
+
+TEST(PartForestTraining, DistanceSpreadMovesTheMotionImagesAndNothingElse) {
+  // --distance-spread-mm: each motion image moved along its palm ray by an offset drawn from
+  // [-spread, spread] (synth --depth-offset), from a stream of its own; the random poses and
+  // everything else as without it.
+  forest::SceneOptions spread;
+  spread.distance_spread_mm = 100.0;
+  const forest::SceneOptions none;
+  int motions = 0;
+  int nearer = 0;
+  int farther = 0;
+  for (uint64_t i = 0; i < 200; ++i) {
+    const forest::Scene s = forest::make_scene(9, i, spread);
+    const forest::Scene plain = forest::make_scene(9, i, none);
+    EXPECT_EQ(plain.options.depth_offset_mm, 0.0);
+    EXPECT_EQ(s.options.seed, plain.options.seed);
+    EXPECT_EQ(s.options.view, plain.options.view);
+    EXPECT_EQ(s.pose.translation_mm, plain.pose.translation_mm);
+    if (!s.from_motion) {
+      EXPECT_EQ(s.options.depth_offset_mm, 0.0);
+      continue;
+    }
+    ++motions;
+    EXPECT_LE(std::abs(s.options.depth_offset_mm), 100.0);
+    nearer += s.options.depth_offset_mm < -50.0 ? 1 : 0;
+    farther += s.options.depth_offset_mm > 50.0 ? 1 : 0;
+  }
+  EXPECT_GT(motions, 30);
+  EXPECT_GT(nearer, motions / 8);
+  EXPECT_GT(farther, motions / 8);
 }
 
 TEST(SynthRenderPose, RenderingAMotionsPoseEqualsRenderingItsFrame) {

@@ -239,6 +239,10 @@ int main(int argc, char** argv) {
                  "Share of images whose hand has varied proportions (finger lengths, girth, palm thickness: "
                  "handtrack-synth --proportions varied)")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--distance-spread-mm", scene.distance_spread_mm,
+                 "Motion images moved nearer or farther along their palm ray by up to this many mm (handtrack-synth "
+                 "--depth-offset; default 0: where the motions hold the hand)")
+      ->check(CLI::Range(0.0, 250.0));
   app.add_option("--pose-far-mm", scene.far_mm, "Farthest palm depth of the random poses (from 250 mm)")
       ->check(CLI::Range(300.0, 1500.0))
       ->capture_default_str();
@@ -301,7 +305,7 @@ int main(int argc, char** argv) {
             << " --min-leaf " << train.min_leaf_samples << " --motion-fraction " << scene.motion_fraction
             << " --turned-fraction " << scene.turned_fraction << " --view-fraction " << scene.view_fraction
             << " --ball-fraction " << scene.ball_fraction << " --body-fraction " << scene.body_fraction
-            << " --varied-fraction " << scene.varied_fraction
+            << " --varied-fraction " << scene.varied_fraction << " --distance-spread-mm " << scene.distance_spread_mm
             << " --pose-far-mm " << scene.far_mm
             << " --volume-far-mm " << scene.volume_far_mm << " --seed " << train.seed;
     const auto t1 = std::chrono::steady_clock::now();

@@ -64,6 +64,11 @@ struct SceneOptions {
   // finger's length, the fingers' girth and the palm's thickness drawn beside the subject's size).
   // Drawn from a stream of its own, so 0 leaves the data set unchanged.
   double varied_fraction = 0.0;
+  // The motion images moved along their palm ray by a depth offset drawn uniformly from
+  // [-spread, spread] mm (synth --depth-offset): the motions hold the palm 350-520 mm away, the
+  // random poses 250-far_mm. Drawn from a stream of its own, so 0 leaves the data set unchanged
+  // (docs/TRACKER.md, "Hands nearer and farther").
+  double distance_spread_mm = 0.0;
   CameraIntrinsics camera = synth::default_camera();
 };
 
