@@ -411,6 +411,14 @@ TEST(PartForestTraining, FartherPosesAndWorkingVolumeGiveFartherHands) {
   EXPECT_GT(deepest_mask_pixel(850.0), 650.0F);
 }
 
+// A scene drawn with one option on is the scene drawn without it in everything the option does not
+// draw: its noise seed, its view and where its hand is.
+void expect_the_same_scene_otherwise(const forest::Scene& s, const forest::Scene& plain) {
+  EXPECT_EQ(s.options.seed, plain.options.seed);
+  EXPECT_EQ(s.options.view, plain.options.view);
+  EXPECT_EQ(s.pose.translation_mm, plain.pose.translation_mm);
+}
+
 TEST(PartForestTraining, BodyImagesAreTheBodyWithoutTheHandAllBackground) {
   // --body-fraction: an image is the body of a near-body scene (synth --background near-body) once
   // the hand and its forearm are gone, labelled background; 0 leaves every scene as it was.
@@ -424,8 +432,7 @@ TEST(PartForestTraining, BodyImagesAreTheBodyWithoutTheHandAllBackground) {
     const forest::Scene s = forest::make_scene(9, i, o);
     const forest::Scene plain = forest::make_scene(9, i, none);
     EXPECT_FALSE(plain.body);
-    EXPECT_EQ(s.options.seed, plain.options.seed);  // the body is drawn last: the rest is unchanged
-    EXPECT_EQ(s.pose.translation_mm, plain.pose.translation_mm);
+    expect_the_same_scene_otherwise(s, plain);  // the body is drawn last: the rest is unchanged
     if (!s.body) {
       EXPECT_EQ(s.options.view, synth::View::kHeadMounted);  // a near body is for the desk camera's views
       continue;
@@ -456,9 +463,7 @@ TEST(PartForestTraining, VariedFractionVariesTheHandsAndNothingElse) {
     const forest::Scene s = forest::make_scene(9, i, half);
     const forest::Scene plain = forest::make_scene(9, i, none);
     EXPECT_EQ(plain.options.proportions, synth::Proportions::kMean);
-    EXPECT_EQ(s.options.seed, plain.options.seed);
-    EXPECT_EQ(s.options.view, plain.options.view);
-    EXPECT_EQ(s.pose.translation_mm, plain.pose.translation_mm);
+    expect_the_same_scene_otherwise(s, plain);
     varied += s.options.proportions == synth::Proportions::kVaried ? 1 : 0;
   }
   EXPECT_GT(varied, kScenes * 35 / 100);
@@ -479,9 +484,7 @@ TEST(PartForestTraining, DistanceSpreadMovesTheMotionImagesAndNothingElse) {
     const forest::Scene s = forest::make_scene(9, i, spread);
     const forest::Scene plain = forest::make_scene(9, i, none);
     EXPECT_EQ(plain.options.depth_offset_mm, 0.0);
-    EXPECT_EQ(s.options.seed, plain.options.seed);
-    EXPECT_EQ(s.options.view, plain.options.view);
-    EXPECT_EQ(s.pose.translation_mm, plain.pose.translation_mm);
+    expect_the_same_scene_otherwise(s, plain);
     if (!s.from_motion) {
       EXPECT_EQ(s.options.depth_offset_mm, 0.0);
       continue;
