@@ -203,7 +203,7 @@ void posed_primitives(const HandShape& shape, const HandPose& pose, const Joints
     forearm.b = forearm.a + (shape.forearm.b - shape.forearm.a).norm() * *shape.forearm_camera_direction;
   }
   out.push_back(forearm);
-  // The upper arm, a third thicker at the elbow than the forearm, as thick again at the shoulder.
+  // The upper arm: 30 % thicker than the forearm at the elbow, and as thick up to the shoulder.
   constexpr double kUpperArmGirth = 1.3;
   if (shape.upper_arm_camera_direction) {
     const double r = kUpperArmGirth * forearm.radius_b;

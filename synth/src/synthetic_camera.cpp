@@ -227,22 +227,20 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
     throw std::invalid_argument("motion '" + options.motion +
                                 "' shows a right and a left hand in its own arrangement: no hand or view to choose");
   }
-  const bool one_hand_scene = options.background == Background::kDesk || options.ball_radius_mm > 0.0;
-  if (is_two_hand_motion(options.motion) && one_hand_scene) {
-    throw std::invalid_argument("motion '" + options.motion +
-                                "': the desk background and a held ball are for one-hand motions");
+  // What only a scene of one hand has: a two-hand motion places both hands itself.
+  const char* one_hand_only = options.background == Background::kDesk ? "the desk background"
+                              : options.ball_radius_mm > 0.0          ? "a held ball"
+                              : options.depth_offset_mm != 0.0        ? "a depth offset"
+                              : options.upper_arm                     ? "the upper arm"
+                                                                      : nullptr;
+  if (is_two_hand_motion(options.motion) && one_hand_only != nullptr) {
+    throw std::invalid_argument("motion '" + options.motion + "': " + one_hand_only + " is for one-hand motions");
   }
   if (!(options.ball_radius_mm >= 0.0 && options.ball_radius_mm <= kMaxBallRadiusMm)) {
     throw std::invalid_argument("ball radius must be within [0, 100] mm");
   }
   if (!(std::abs(options.depth_offset_mm) <= kMaxDepthOffsetMm)) {
     throw std::invalid_argument("depth offset must be within [-250, 250] mm");
-  }
-  if (is_two_hand_motion(options.motion) && options.depth_offset_mm != 0.0) {
-    throw std::invalid_argument("motion '" + options.motion + "': a depth offset is for one-hand motions");
-  }
-  if (is_two_hand_motion(options.motion) && options.upper_arm) {
-    throw std::invalid_argument("motion '" + options.motion + "': the upper arm is for one-hand motions");
   }
   std::array<SubjectScale, kTwoHands> subjects;
   if (options.subject) {

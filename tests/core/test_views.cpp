@@ -428,9 +428,9 @@ TEST(HeadMountedPinch, IsHeldWhereTheCameraSeesTheBackOfTheHand) {
   EXPECT_LT(shipped, papers - 1.5);
 }
 
-// A hand held farther away, 440-560 mm (handtrack-synth --depth-offset 80), its forearm reaching
-// back through the far plane (600 mm): the far plane cuts as large a share of the small outline as
-// of a shoulder reaching into the working volume (docs/TRACKER.md, "Hands nearer and farther").
+// A hand held 80 mm farther than the motion holds it (handtrack-synth --depth-offset 80), its
+// forearm reaching back through the far plane (600 mm): the far plane cuts as large a share of the
+// small outline as of a shoulder reaching into the working volume (docs/TRACKER.md, "Hands nearer and farther").
 // Before the rule asked how far the surface reaches in (kMinHandReachMm), 193 of 25,200 such
 // frames of the benchmark's scenes had no hand, many of them fists, the smallest outlines.
 // Measured on seeds 21-23 when written: a pose in 900 of 900 frames, 7.7 mm; before, in 881.

@@ -126,7 +126,8 @@ Joints camera_frame_joints(const HandShape& shape, const HandPose& pose);
 Fingertips fingertips_from_joints(const Joints& joints);
 
 // All primitives of the posed hand in the camera frame: 15 phalanges (labels from part_label()),
-// the palm, the forearm and, where the shape has a shoulder, the upper arm. `out` is cleared and refilled (no allocation once it has grown).
+// the palm, the forearm and, where the shape has one, the upper arm. `out` is cleared and refilled
+// (no allocation once it has grown).
 void posed_primitives(const HandShape& shape, const HandPose& pose, const Joints& camera_joints,
                       std::vector<ConeSphere>& out);
 
