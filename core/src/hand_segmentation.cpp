@@ -27,6 +27,18 @@ constexpr double kHandLengthMargin = 1.1;
 constexpr double kWristCutMarginMm = 10.0;
 // Pixels this close to the image border mark the end of a blob where the arm leaves the image.
 constexpr int kBorderPx = 3;
+// A surface whose ends tie (neither or both leave the image) may be a hand without its arm; it is
+// read as one where it is longer than a fist (an adult fist from the wrist to the knuckles is
+// 100-110 mm, 0.6 hand lengths) and no longer than this many hand lengths. Along its principal
+// axis a hand alone measures its own length plus about 20 mm (the heel of the palm, the tip's
+// skin): 1.10 lengths for a hand 7 % longer than the model's; a hand with its forearm going away
+// behind fingers that point at the camera measured 1.14-1.6 (docs/TRACKER.md, "A hand without
+// its arm").
+constexpr double kFistInLengths = 0.6;
+constexpr double kHandAloneInLengths = 1.25;
+// There the fingers are the end farther from the palm only where the two ends' distances from it
+// differ by at least this (mm); otherwise the end nearer the camera is the hand, as for an arm.
+constexpr double kEndsAlikeMm = 20.0;
 
 // Whether a 4-neighbour of pixel (u, v) has a measured depth nearer than the working volume: the
 // surface leaves the volume toward the camera there.
@@ -226,9 +238,45 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
       end->depth += (*segmented)[i];
       ++end->pixels;
     }
-    const bool top_is_hand = top.border != bottom.border ? top.border < bottom.border
-                                                         : top.depth / std::max(1, top.pixels) <=
-                                                               bottom.depth / std::max(1, bottom.pixels);
+    const double length = config.hand_length_mm;
+    std::vector<int>& dist = stack_;
+    // Each pixel of the blob among those `in` gets its chamfer distance to their outline (about 3 x
+    // pixels); returns the pixel where `weight(i) * dist[i]` is largest.
+    const auto widest = [&](const auto& in, const auto& weight) {
+      dist.assign(n, 0);
+      for (size_t i = 0; i < n; ++i) {
+        if (component_[i] == best && in(i)) dist[i] = 1 << 20;
+      }
+      chamfer_transform(dist, w, h, 0, [&](size_t i) { return dist[i] != 0; });
+      size_t at = 0;
+      double most = 0.0;
+      for (size_t i = 0; i < n; ++i) {
+        const double d = weight(i) * dist[i];
+        if (d > most) {
+          most = d;
+          at = i;
+        }
+      }
+      return at;
+    };
+    bool top_is_hand = top.border < bottom.border;
+    if (top.border == bottom.border) {
+      // Neither end leaves the image or the volume (or both do). A hand without its arm (a
+      // renderer's hand model cut at the wrist) has its fingers at the end farther from its widest
+      // part, the palm: an open hand's middle fingertip about 0.75 hand lengths from the palm
+      // centre, the wrist 0.25. Widths in mm here (pixels x depth): in pixels the end nearer the
+      // camera looks widest. Otherwise (a forearm going back through the far plane, or seen along
+      // its length behind fingers that point at the camera; a fist), the hand is the end nearer the
+      // camera.
+      top_is_hand = top.depth / std::max(1, top.pixels) <= bottom.depth / std::max(1, bottom.pixels);
+      if (hi - lo > kFistInLengths * length && hi - lo <= kHandAloneInLengths * length) {
+        const auto all = [](size_t) { return true; };
+        const double s = (point(widest(all, [&](size_t i) { return (*segmented)[i]; })) - mean).dot(axis);
+        const double to_top = hi - s;
+        const double to_bottom = s - lo;
+        if (std::abs(to_top - to_bottom) >= kEndsAlikeMm) top_is_hand = to_top > to_bottom;
+      }
+    }
     if (!top_is_hand) {
       axis = -axis;
       std::swap(lo, hi);
@@ -236,18 +284,11 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
       hi = -hi;
     }
     // The palm centre is the hand pixel farthest from the hand's outline (the centre of the largest
-    // inscribed disc): the palm is the widest part of a hand, open or closed, and wider than the
-    // forearm. Search within one hand length of the tip. (In pixels: weighting by depth, to compare
-    // widths in mm, put the centre on the forearm behind a fist; docs/TRACKER.md "Segmentation".)
-    const double length = config.hand_length_mm;
-    std::vector<int>& dist = stack_;
-    dist.assign(n, 0);
-    for (size_t i = 0; i < n; ++i) {
-      if (component_[i] == best && (point(i) - mean).dot(axis) >= hi - length) dist[i] = 1 << 20;
-    }
-    chamfer_transform(dist, w, h, 0, [&](size_t i) { return dist[i] != 0; });  // distance to the outline
-    const auto centre_px = static_cast<size_t>(std::max_element(dist.begin(), dist.end()) - dist.begin());
-    centre = point(centre_px);
+    // inscribed disc), within one hand length of the tip: the palm is the widest part of a hand, open
+    // or closed, and wider than the forearm. (In pixels: weighting by depth, to compare widths in mm,
+    // put the centre on the forearm behind a fist; docs/TRACKER.md "Segmentation".)
+    centre = point(widest([&](size_t i) { return (point(i) - mean).dot(axis) >= hi - length; },
+                          [](size_t) { return 1.0; }));
     // The wrist sits about half a palm below the palm centre.
     wrist = centre - axis * (kWristBelowPalmCentre * length);
     count = select();

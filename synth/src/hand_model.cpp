@@ -202,6 +202,7 @@ void posed_primitives(const HandShape& shape, const HandPose& pose, const Joints
   if (shape.forearm_camera_direction) {
     forearm.b = forearm.a + (shape.forearm.b - shape.forearm.a).norm() * *shape.forearm_camera_direction;
   }
+  if (!shape.forearm_shown) return;
   out.push_back(forearm);
   // The upper arm: 30 % thicker than the forearm at the elbow, and as thick up to the shoulder.
   constexpr double kUpperArmGirth = 1.3;

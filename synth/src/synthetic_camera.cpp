@@ -136,6 +136,25 @@ std::optional<Proportions> parse_proportions(std::string_view name) {
   return std::nullopt;
 }
 
+std::string_view arm_name(Arm arm) {
+  switch (arm) {
+    case Arm::kNone:
+      return "none";
+    case Arm::kForearm:
+      return "forearm";
+    case Arm::kShoulder:
+      return "shoulder";
+  }
+  return "forearm";
+}
+
+std::optional<Arm> parse_arm(std::string_view name) {
+  for (Arm a : {Arm::kNone, Arm::kForearm, Arm::kShoulder}) {
+    if (arm_name(a) == name) return a;
+  }
+  return std::nullopt;
+}
+
 std::string_view handedness_name(Handedness hand) { return hand == Handedness::kLeft ? "left" : "right"; }
 
 std::optional<Handedness> parse_handedness(std::string_view name) {
@@ -231,7 +250,8 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   const char* one_hand_only = options.background == Background::kDesk ? "the desk background"
                               : options.ball_radius_mm > 0.0          ? "a held ball"
                               : options.depth_offset_mm != 0.0        ? "a depth offset"
-                              : options.upper_arm                     ? "the upper arm"
+                              : options.arm == Arm::kShoulder         ? "the upper arm"
+                              : options.arm == Arm::kNone             ? "a hand without its arm"
                                                                       : nullptr;
   if (is_two_hand_motion(options.motion) && one_hand_only != nullptr) {
     throw std::invalid_argument("motion '" + options.motion + "': " + one_hand_only + " is for one-hand motions");
@@ -277,7 +297,15 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   const View arrangement = seen_in(options.motion, options.view);
   const auto shape_of = [&](const SubjectScale& subject) {
     HandShape shape = view_shape(arrangement, HandShape::for_subject(subject));
-    return options.upper_arm ? with_upper_arm(arrangement, std::move(shape)) : shape;
+    switch (options.arm) {
+      case Arm::kNone:
+        return without_arm(std::move(shape));
+      case Arm::kShoulder:
+        return with_upper_arm(arrangement, std::move(shape));
+      case Arm::kForearm:
+        break;
+    }
+    return shape;
   };
   const std::array<HandShape, kTwoHands> shapes{shape_of(subjects[0]), shape_of(subjects[1])};
   state_ = std::make_unique<State>(std::move(options), shapes);

@@ -83,4 +83,9 @@ HandShape with_upper_arm(View view, HandShape shape) {
   return shape;
 }
 
+HandShape without_arm(HandShape shape) {
+  shape.forearm_shown = false;
+  return shape;
+}
+
 }  // namespace handtrack::synth

@@ -45,6 +45,12 @@ std::ptrdiff_t hand_pixels(const handtrack::SequenceReader& reader) {
   return labels ? std::count_if(labels->pixels.begin(), labels->pixels.end(), [](uint8_t l) { return l != 0; }) : 0;
 }
 
+// Pixels of the first frame with a depth beyond `beyond_mm`.
+std::ptrdiff_t pixels_beyond(const handtrack::SequenceReader& reader, float beyond_mm) {
+  const auto depth = reader.depth(0).depth_mm;
+  return std::count_if(depth.begin(), depth.end(), [&](float d) { return d > beyond_mm; });
+}
+
 class SynthCli : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -105,7 +111,9 @@ TEST_F(SynthCli, BadArgumentsGiveOneClearLine) {
   expect_one_line_error("--motion pinch --frames 5 --fov 170 " + out, "--fov");
   expect_one_line_error("--motion pinch --frames 5 --depth-offset 400 " + out, "--depth-offset");
   expect_one_line_error("--motion two_apart --frames 5 --depth-offset 50 " + out, "depth offset");
-  expect_one_line_error("--motion two_apart --frames 5 --upper-arm " + out, "upper arm");
+  expect_one_line_error("--motion two_apart --frames 5 --arm shoulder " + out, "upper arm");
+  expect_one_line_error("--motion two_apart --frames 5 --arm none " + out, "without its arm");
+  expect_one_line_error("--motion pinch --frames 5 --arm elbow " + out, "--arm");
   expect_one_line_error("--motion pinch --frames 5", "--out");
   expect_one_line_error("--frames 5 " + out, "--motion");
   expect_one_line_error("--motion pinch --bogus " + out, "bogus");
@@ -213,17 +221,27 @@ TEST_F(SynthCli, ADepthOffsetMovesTheHandAlongItsRay) {
   EXPECT_LT(hand_pixels(b), hand_pixels(a) * 3 / 4);
 }
 
-// --upper-arm: the arm goes on past the elbow, back to the shoulder: more of the image has depth,
-// none of it the hand's, some of it beyond the working volume (600 mm) as the arm reaches back.
+// --arm shoulder: the arm goes on past the elbow, back to the shoulder: more of the image has
+// depth, none of it the hand's, some of it beyond the working volume (600 mm) as the arm reaches
+// back.
 TEST_F(SynthCli, AnUpperArmGoesOnFromTheElbowToTheShoulder) {
-  const auto [a, b] = plain_and("--upper-arm");
-  const auto pixels = [](const handtrack::SequenceReader& reader, float beyond_mm) {
-    const auto depth = reader.depth(0).depth_mm;
-    return std::count_if(depth.begin(), depth.end(), [&](float d) { return d > beyond_mm; });
-  };
-  EXPECT_GT(pixels(b, 0.0F), pixels(a, 0.0F) + 1000);
-  EXPECT_GT(pixels(b, 600.0F), pixels(a, 600.0F) + 100);
+  const auto [a, b] = plain_and("--arm shoulder");
+  EXPECT_GT(pixels_beyond(b, 0.0F), pixels_beyond(a, 0.0F) + 1000);
+  EXPECT_GT(pixels_beyond(b, 600.0F), pixels_beyond(a, 600.0F) + 100);
   EXPECT_EQ(hand_pixels(b), hand_pixels(a));
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "changed" / "subject.json")).at("arm"), "shoulder");
+}
+
+// --arm none: the hand alone, cut at the wrist: the forearm's pixels are gone, the hand's all there
+// (with the forearm gone, a few of the wrist's come out from behind it), and subject.json says so.
+TEST_F(SynthCli, AHandWithoutItsArmIsCutAtTheWrist) {
+  const auto [a, b] = plain_and("--arm none");
+  EXPECT_LT(pixels_beyond(b, 0.0F), pixels_beyond(a, 0.0F) - 1000);
+  EXPECT_GE(hand_pixels(b), hand_pixels(a));
+  EXPECT_LT(hand_pixels(b), hand_pixels(a) + hand_pixels(a) / 20);
+  EXPECT_EQ(pixels_beyond(b, 0.0F), hand_pixels(b)) << "nothing but the hand has depth";
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "plain" / "subject.json")).at("arm"), "forearm");
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "changed" / "subject.json")).at("arm"), "none");
 }
 
 // --proportions varied: subject.json says so and gives each hand's proportions, which its bone

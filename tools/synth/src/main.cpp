@@ -98,6 +98,7 @@ void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticC
                       {"background", std::string(handtrack::synth::background_name(o.background))},
                       {"ball_radius_mm", o.ball_radius_mm},
                       {"proportions", std::string(handtrack::synth::proportions_name(o.proportions))},
+                      {"arm", std::string(handtrack::synth::arm_name(o.arm))},
                       {"pose_parameters", "poses.csv: frame, t_x,t_y,t_z (mm, wrist), r_x,r_y,r_z (axis-angle, "
                                           "R = exp(r) diag(1,-1,-1)), thumb..little abd,flex1,flex2,flex3 (rad)"}};
   if (cam.hand_count() == 1) {
@@ -229,9 +230,11 @@ int main(int argc, char** argv) {
                  "Move the hand this many mm along the ray through its palm centre in every frame: negative nearer "
                  "the camera, positive farther (default 0: where the view puts it; one-hand motions)")
       ->check(CLI::Range(-250.0, 250.0));
-  app.add_flag("--upper-arm", options.upper_arm,
-               "Render the arm on past the elbow to the shoulder of a user facing the camera (desk views; "
-               "one-hand motions). Default: the forearm ends at the elbow");
+  std::string arm = "forearm";
+  app.add_option("--arm", arm,
+                 "How much of the arm to render: forearm (default: it ends at the elbow), none (the hand alone, cut "
+                 "at the wrist, as renderers of a hand model without an arm draw it) or shoulder (on past the elbow "
+                 "to the shoulder of a user facing the camera; desk views); none and shoulder: one-hand motions");
   double fov_deg = 0.0;
   app.add_option("--fov", fov_deg,
                  "Horizontal field of view in degrees (default: the SPEC.md camera's 70.9; a Kinect's is about 58, a "
@@ -280,6 +283,8 @@ int main(int argc, char** argv) {
   if (!handedness) return fail("--hand must be right or left, got '" + hand + "'");
   const auto shape_proportions = handtrack::synth::parse_proportions(proportions);
   if (!shape_proportions) return fail("--proportions must be mean or varied, got '" + proportions + "'");
+  const auto shown_arm = handtrack::synth::parse_arm(arm);
+  if (!shown_arm) return fail("--arm must be none, forearm or shoulder, got '" + arm + "'");
 
   try {
     options.motion = motion;
@@ -288,6 +293,7 @@ int main(int argc, char** argv) {
     options.ball_radius_mm = ball_radius_mm;
     options.hand = *handedness;
     options.proportions = *shape_proportions;
+    options.arm = *shown_arm;
     options.view = *arrangement;
     options.camera = app.count("--fov") > 0 ? handtrack::synth::camera_with_fov(width, height, fov_deg)
                                             : handtrack::synth::default_camera(width, height);

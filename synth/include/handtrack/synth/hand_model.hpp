@@ -100,6 +100,7 @@ struct HandShape {
   std::array<FingerShape, kNumFingers> fingers{};
   std::vector<ConeSphere> palm;  // rigid in the hand frame, label kPalm (includes the wrist region)
   ConeSphere forearm;            // rigid in the hand frame, label 0
+  bool forearm_shown = true;     // false: the hand alone, cut at the wrist (views.hpp, without_arm)
   // When set, the forearm leaves its start (forearm.a, still rigid in the hand frame) along this
   // unit direction of the camera frame, whatever the hand's rotation: the wrist bends, and the
   // elbow stays where the arrangement puts it (the head-mounted view: views.hpp, view_shape).

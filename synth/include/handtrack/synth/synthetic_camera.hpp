@@ -62,6 +62,13 @@ enum class Proportions { kMean, kVaried };
 std::string_view proportions_name(Proportions proportions);  // "mean", "varied"
 std::optional<Proportions> parse_proportions(std::string_view name);
 
+// How much of the arm the scene shows: the hand alone, cut at the wrist, as renderers of a hand
+// model without an arm (or a hand out of a sleeve) show it; the forearm to a rounded elbow (the
+// default); or the arm on past the elbow to the shoulder (views.hpp, with_upper_arm).
+enum class Arm { kNone, kForearm, kShoulder };
+std::string_view arm_name(Arm arm);  // "none", "forearm", "shoulder"
+std::optional<Arm> parse_arm(std::string_view name);
+
 // The SPEC.md camera (fx 224.502, fy 230.494 at 320x240, principal point at the image centre,
 // 60 fps, 1 mm depth units) with the focal lengths scaled to width x height.
 CameraIntrinsics default_camera(int width = 320, int height = 240);
@@ -95,10 +102,9 @@ struct SynthOptions {
   // camera, > 0 farther (mm, within [-250, 250]; one-hand motions). The motion's own movement
   // and the scene behind the hand stay as they are.
   double depth_offset_mm = 0.0;
-  // The arm goes on past the elbow to the shoulder (views.hpp, with_upper_arm; one-hand motions).
-  // Off: the forearm ends in a rounded elbow, which a wide lens shows (docs/TRACKER.md, "Other
-  // cameras").
-  bool upper_arm = false;
+  // How much of the arm is drawn (one-hand motions, but for the default). The forearm ends in a
+  // rounded elbow, which a wide lens shows (docs/TRACKER.md, "Other cameras").
+  Arm arm = Arm::kForearm;
 };
 
 // The virtual camera as handtrackd's `synthetic[:MOTION]` source shows it: `frames` per pass of

@@ -53,4 +53,8 @@ HandShape view_shape(View view, HandShape shape);
 // elbow is below the camera and its upper arm behind it: unchanged.
 HandShape with_upper_arm(View view, HandShape shape);
 
+// `shape` without its forearm: the hand alone, cut at the wrist (the palm's heel stays), as
+// renderers of a hand model without an arm draw it.
+HandShape without_arm(HandShape shape);
+
 }  // namespace handtrack::synth
