@@ -267,9 +267,12 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
       // centre, the wrist 0.25. Widths in mm here (pixels x depth): in pixels the end nearer the
       // camera looks widest. Otherwise (a forearm going back through the far plane, or seen along
       // its length behind fingers that point at the camera; a fist), the hand is the end nearer the
-      // camera.
+      // camera. So too in a frame shared out among hands: there a surface no longer than a hand is
+      // as often a tracked hand's forearm, cut off from it at the wrist, and read as a hand without
+      // its arm it was fitted with fingers along it (a phantom second hand in 80 % of the frames of
+      // random, subjects 1 and 2).
       top_is_hand = top.depth / std::max(1, top.pixels) <= bottom.depth / std::max(1, bottom.pixels);
-      if (hi - lo > kFistInLengths * length && hi - lo <= kHandAloneInLengths * length) {
+      if (!shared_out && hi - lo > kFistInLengths * length && hi - lo <= kHandAloneInLengths * length) {
         const auto all = [](size_t) { return true; };
         const double s = (point(widest(all, [&](size_t i) { return (*segmented)[i]; })) - mean).dot(axis);
         const double to_top = hi - s;
@@ -292,7 +295,7 @@ void HandSegmenter::segment(const DepthInputConfig& config, const std::vector<fl
     // The wrist sits about half a palm below the palm centre.
     wrist = centre - axis * (kWristBelowPalmCentre * length);
     count = select();
-    if (reaches_in_through_far_plane(config, unclamped_mm, component_, best, w, h)) count = 0;
+    if (reaches_in_through_far_plane(config, far_plane_cut(config, unclamped_mm, component_, best, w, h))) count = 0;
   }
   out.hand_pixels = count;
   out.finger_axis = axis;

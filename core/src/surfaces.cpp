@@ -34,8 +34,8 @@ void label_surfaces(const DepthInputConfig& config, const std::vector<float>& d,
   }
 }
 
-bool reaches_in_through_far_plane(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
-                                  const std::vector<int>& component, int blob, int w, int h) {
+FarPlaneCut far_plane_cut(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
+                          const std::vector<int>& component, int blob, int w, int h) {
   const auto far = static_cast<float>(config.far_mm);
   const auto reach = static_cast<float>(config.far_mm + config.continuity_mm);
   int boundary = 0;
@@ -60,8 +60,7 @@ bool reaches_in_through_far_plane(const DepthInputConfig& config, const std::vec
       continued += beyond ? 1 : 0;
     }
   }
-  const double cut = boundary > 0 ? static_cast<double>(continued) / boundary : 0.0;
-  return cut > kMaxFarPlaneCut && nearest > far - kMinHandReachMm;
+  return {boundary > 0 ? static_cast<double>(continued) / boundary : 0.0, nearest};
 }
 
 }  // namespace handtrack

@@ -78,10 +78,19 @@ inline constexpr double kMaxFarPlaneCut = 0.15;
 // of the suite's test 60 (docs/TRACKER.md, "Hands nearer and farther").
 inline constexpr double kMinHandReachMm = 100.0;
 
-// Whether surface `blob` is a larger surface reaching into the working volume through its far
-// plane: more than kMaxFarPlaneCut of its outline where the depth (before the working volume:
-// `unclamped_mm`) goes on just beyond the far plane, and no pixel kMinHandReachMm nearer than it.
-bool reaches_in_through_far_plane(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
-                                  const std::vector<int>& component, int blob, int w, int h);
+// Where surface `blob` meets the far plane: the share of its outline where the depth (before the
+// working volume: `unclamped_mm`) goes on just beyond the far plane, and its nearest depth.
+struct FarPlaneCut {
+  double share = 0.0;
+  float nearest_mm = 0.0F;
+};
+FarPlaneCut far_plane_cut(const DepthInputConfig& config, const std::vector<float>& unclamped_mm,
+                          const std::vector<int>& component, int blob, int w, int h);
+
+// Whether a surface so cut is a larger surface reaching into the working volume through its far
+// plane: more than kMaxFarPlaneCut of its outline, and no pixel kMinHandReachMm nearer than it.
+inline bool reaches_in_through_far_plane(const DepthInputConfig& config, const FarPlaneCut& cut) {
+  return cut.share > kMaxFarPlaneCut && cut.nearest_mm > config.far_mm - kMinHandReachMm;
+}
 
 }  // namespace handtrack
