@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <optional>
 #include <span>
@@ -96,6 +97,15 @@ ConeSphere held_ball(const HandShape& shape, const HandPose& pose, double r) {
   return ConeSphere{c, c, r, r, kBackground};
 }
 
+// The one of `values` that `name_of` names `name`.
+template <typename E>
+std::optional<E> by_name(std::string_view name, std::initializer_list<E> values, std::string_view (*name_of)(E)) {
+  for (E e : values) {
+    if (name_of(e) == name) return e;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::string_view background_name(Background background) {
@@ -115,10 +125,8 @@ std::string_view background_name(Background background) {
 }
 
 std::optional<Background> parse_background(std::string_view name) {
-  for (auto b : {Background::kNone, Background::kBody, Background::kTable, Background::kDesk, Background::kNearBody}) {
-    if (background_name(b) == name) return b;
-  }
-  return std::nullopt;
+  return by_name(name, {Background::kNone, Background::kBody, Background::kTable, Background::kDesk, Background::kNearBody},
+                 background_name);
 }
 
 Background default_background(std::string_view motion, View view) {
@@ -130,10 +138,7 @@ std::string_view proportions_name(Proportions proportions) {
 }
 
 std::optional<Proportions> parse_proportions(std::string_view name) {
-  for (Proportions p : {Proportions::kMean, Proportions::kVaried}) {
-    if (proportions_name(p) == name) return p;
-  }
-  return std::nullopt;
+  return by_name(name, {Proportions::kMean, Proportions::kVaried}, proportions_name);
 }
 
 std::string_view arm_name(Arm arm) {
@@ -149,19 +154,13 @@ std::string_view arm_name(Arm arm) {
 }
 
 std::optional<Arm> parse_arm(std::string_view name) {
-  for (Arm a : {Arm::kNone, Arm::kForearm, Arm::kShoulder}) {
-    if (arm_name(a) == name) return a;
-  }
-  return std::nullopt;
+  return by_name(name, {Arm::kNone, Arm::kForearm, Arm::kShoulder}, arm_name);
 }
 
 std::string_view handedness_name(Handedness hand) { return hand == Handedness::kLeft ? "left" : "right"; }
 
 std::optional<Handedness> parse_handedness(std::string_view name) {
-  for (auto h : {Handedness::kRight, Handedness::kLeft}) {
-    if (handedness_name(h) == name) return h;
-  }
-  return std::nullopt;
+  return by_name(name, {Handedness::kRight, Handedness::kLeft}, handedness_name);
 }
 
 namespace {
