@@ -499,6 +499,25 @@ TEST(PartForestTraining, DistanceSpreadMovesTheMotionImagesAndNothingElse) {
   EXPECT_GT(farther, motions / 8);
 }
 
+TEST(PartForestTraining, ArmlessFractionDrawsThatShareWithoutTheArmAndNothingElse) {
+  // --armless-fraction: a share of the images' hands drawn without the arm (synth --arm none), from
+  // a stream of its own; everything else as without it.
+  forest::SceneOptions armless;
+  armless.armless_fraction = 0.5;
+  const forest::SceneOptions none;
+  constexpr int kScenes = 200;
+  int without = 0;
+  for (uint64_t i = 0; i < kScenes; ++i) {
+    const forest::Scene s = forest::make_scene(9, i, armless);
+    const forest::Scene plain = forest::make_scene(9, i, none);
+    EXPECT_EQ(plain.options.arm, synth::Arm::kForearm);
+    expect_the_same_scene_otherwise(s, plain);
+    without += s.options.arm == synth::Arm::kNone ? 1 : 0;
+  }
+  EXPECT_GT(without, kScenes * 35 / 100);
+  EXPECT_LT(without, kScenes * 65 / 100);
+}
+
 TEST(SynthRenderPose, RenderingAMotionsPoseEqualsRenderingItsFrame) {
   synth::SynthOptions o;
   o.motion = "tigergrasp";

@@ -69,6 +69,10 @@ struct SceneOptions {
   // random poses 250-far_mm. Drawn from a stream of its own, so 0 leaves the data set unchanged
   // (docs/TRACKER.md, "Hands nearer and farther").
   double distance_spread_mm = 0.0;
+  // Share of the images whose hand is drawn without its arm, cut at the wrist (synth --arm none: a
+  // renderer's hand model). Drawn from a stream of its own, so 0 leaves the data set unchanged
+  // (docs/TRACKER.md, "A hand without its arm").
+  double armless_fraction = 0.0;
   CameraIntrinsics camera = synth::default_camera();
 };
 
