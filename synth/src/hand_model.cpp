@@ -198,11 +198,11 @@ void posed_primitives(const HandShape& shape, const HandPose& pose, const Joints
     }
   }
   for (const auto& c : shape.palm) out.push_back(to_camera(c));
+  if (!shape.forearm_shown) return;  // nor an upper arm beyond it
   ConeSphere forearm = to_camera(shape.forearm);
   if (shape.forearm_camera_direction) {
     forearm.b = forearm.a + (shape.forearm.b - shape.forearm.a).norm() * *shape.forearm_camera_direction;
   }
-  if (!shape.forearm_shown) return;
   out.push_back(forearm);
   // The upper arm: 30 % thicker than the forearm at the elbow, and as thick up to the shoulder.
   constexpr double kUpperArmGirth = 1.3;

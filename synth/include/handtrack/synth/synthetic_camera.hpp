@@ -63,7 +63,7 @@ std::string_view proportions_name(Proportions proportions);  // "mean", "varied"
 std::optional<Proportions> parse_proportions(std::string_view name);
 
 // How much of the arm the scene shows: the hand alone, cut at the wrist, as renderers of a hand
-// model without an arm (or a hand out of a sleeve) show it; the forearm to a rounded elbow (the
+// model without an arm show it; the forearm to a rounded elbow (the
 // default); or the arm on past the elbow to the shoulder (views.hpp, with_upper_arm).
 enum class Arm { kNone, kForearm, kShoulder };
 std::string_view arm_name(Arm arm);  // "none", "forearm", "shoulder"
