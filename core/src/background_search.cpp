@@ -1,29 +1,11 @@
 #include "background_search.hpp"
-
-#include <pthread.h>
-#include <sched.h>
-#include <unistd.h>
+#include "idle_thread.hpp"
 
 namespace handtrack {
 
 namespace {
 // background_searches_finished()
 std::atomic<uint64_t> finished_searches{0};
-
-// The calling thread at SCHED_IDLE, allowed on every online CPU (it inherits the creating
-// thread's policy and CPU, which in handtrackd may be a real-time stage thread pinned to one CPU).
-// Either may fail in a restricted container; the search then runs as its creator does.
-void become_idle_class() {
-  pthread_setname_np(pthread_self(), "ht-search");
-  sched_param param{};
-  param.sched_priority = 0;
-  pthread_setschedparam(pthread_self(), SCHED_IDLE, &param);
-  cpu_set_t cpus;
-  CPU_ZERO(&cpus);
-  const long online = sysconf(_SC_NPROCESSORS_ONLN);
-  for (long c = 0; c < online && c < CPU_SETSIZE; ++c) CPU_SET(static_cast<int>(c), &cpus);
-  pthread_setaffinity_np(pthread_self(), sizeof(cpus), &cpus);
-}
 }  // namespace
 
 uint64_t background_searches_finished() { return finished_searches.load(std::memory_order_relaxed); }
@@ -39,12 +21,7 @@ BackgroundSearch::~BackgroundSearch() {
   stop_.store(true, std::memory_order_relaxed);
   state_.store(State::kStop, std::memory_order_release);
   state_.notify_all();
-  // Back to the normal class, so that a search starved of idle time still reaches its next
-  // hypothesis soon and stops.
-  sched_param param{};
-  param.sched_priority = 0;
-  pthread_setschedparam(thread_.native_handle(), SCHED_OTHER, &param);
-  thread_.join();
+  join_from_idle_class(thread_);  // the search stops at its next hypothesis
 }
 
 void BackgroundSearch::reclaim_dropped() {
@@ -98,7 +75,7 @@ void BackgroundSearch::wait() {
 }
 
 void BackgroundSearch::run() {
-  become_idle_class();
+  become_idle_class("ht-search");
   for (;;) {
     State s = state_.load(std::memory_order_acquire);
     while (s != State::kQueued && s != State::kStop) {

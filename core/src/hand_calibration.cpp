@@ -285,6 +285,12 @@ bool CalibrationSet::offer(const DepthImage& depth, const TrackerOutput& tracked
   return true;
 }
 
+void CalibrationSet::clear() {
+  since_kept_ = 0;
+  inputs_.clear();
+  poses_.clear();
+}
+
 std::vector<CalibrationFrame> CalibrationSet::frames() const {
   std::vector<CalibrationFrame> out;
   for (size_t i = 0; i < inputs_.size(); ++i) out.push_back({&inputs_[i], poses_[i]});

@@ -1,6 +1,7 @@
 #include "handtrack/core/tracker.hpp"
 
 #include "background_search.hpp"
+#include "self_calibration.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -85,7 +86,12 @@ bool checks_off_the_frame(const TrackerConfig& config) {
 
 Tracker::Tracker(const TrackerConfig& config)
     : right_(config), left_(config), inputs_(input_config(config)),
-      current_(config.handedness == HandednessMode::kLeft ? Handedness::kLeft : Handedness::kRight) {}
+      current_(config.handedness == HandednessMode::kLeft ? Handedness::kLeft : Handedness::kRight),
+      calibration_(config.self_calibrate ? std::make_unique<SelfCalibration>(config) : nullptr) {}
+
+Tracker::~Tracker() = default;
+Tracker::Tracker(Tracker&&) noexcept = default;
+Tracker& Tracker::operator=(Tracker&&) noexcept = default;
 
 void Tracker::resume(const TrackerOutput& last) {
   // The hand as it was last seen, its side as it was reported: no trial (the other hand's history
@@ -334,7 +340,26 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
   out.handedness_confidence =
       config().handedness == HandednessMode::kAuto ? std::clamp(std::abs(evidence_), 0.0, 1.0) : 1.0;
   identify(out);
+  if (calibration_) calibrate(inputs, out);
   return out;
+}
+
+void Tracker::wait_for_checks() {
+  right_.wait_for_check();
+  left_.wait_for_check();
+  if (calibration_) calibration_->wait();
+}
+
+void Tracker::calibrate(const TrackerInputs& inputs, const TrackerOutput& out) {
+  // The hand reported, in the frame its side's tracker fits (a trial's frames too: either hand's fit
+  // of a flat hand has the hand's size). Not beside another hand, whose pixels the hand's
+  // re-segmentation could take in.
+  const DepthInput* input = inputs.get(out.handedness);
+  if (beside_other_ || input == nullptr) return;
+  if (const auto scale = calibration_->offer(*input, out, side(out.handedness).hint(), config().scale)) {
+    right_.set_scale(*scale);
+    left_.set_scale(*scale);
+  }
 }
 
 TrackerOutput Tracker::track(const DepthImage& depth, const PixelLabeller* labeller) {
@@ -650,6 +675,7 @@ TrackerOutput PoseTracker::describe(const PoseParams& params, double energy,
   out.state = state;
   out.params = params;
   out.energy = energy;
+  out.scale = config_.scale;
   scratch_.update(model(), params);
   out.joints = scratch_.joints();
   for (int f = 0; f < kNumFingers; ++f) out.fingertips[static_cast<size_t>(f)] = scratch_.fingertip(f);

@@ -25,7 +25,6 @@ struct Frame {
   bool malformed = false;              // buffer does not match its intrinsics: skipped
   bool resolution_changed = false;     // first frame of a new resolution: the tracker restarts
   HandsOutput output;
-  HandScale scale;
   uint64_t seq = 0;                    // daemon frame number (FrameRecord::frame)
   int64_t capture_ns = 0;
   int64_t grab_end_ns = 0;

@@ -40,7 +40,6 @@ void OptimizeStage::step(Frame& f) {
     tracker_->reset();
     f.output = HandsOutput{};
   }
-  f.scale = tracker_->config().scale;
   // What the next frames need (per hand: which of left and right, the hints, the last pose).
   request_.put(tracker_->request());
   f.optimize_end_ns = monotonic_ns();

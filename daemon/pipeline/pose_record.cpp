@@ -45,7 +45,7 @@ ipc::Handedness to_ipc(Handedness hand) {
   return ipc::Handedness::kUnknown;
 }
 
-void fill_hands(const HandsOutput& output, const HandScale& scale, ipc::FrameRecord& record) {
+void fill_hands(const HandsOutput& output, ipc::FrameRecord& record) {
   static_assert(kMaxHands <= extent<decltype(ipc::FrameRecord::hands)>, "every hand of a frame has its record");
   for (Hand& h : record.hands) h = Hand{};
   record.hand_count = 0;
@@ -67,9 +67,9 @@ void fill_hands(const HandsOutput& output, const HandScale& scale, ipc::FrameRec
     put(o.palm_normal, h.palm_normal);
     h.pinch_distance_mm = static_cast<float>(o.pinch_distance_mm);
     h.pinch_strength = static_cast<float>(o.pinch_strength);
-    h.hand_scale[0] = static_cast<float>(scale.length);
-    h.hand_scale[1] = static_cast<float>(scale.width);
-    h.hand_scale[2] = static_cast<float>(scale.sigma);
+    h.hand_scale[0] = static_cast<float>(o.scale.length);
+    h.hand_scale[1] = static_cast<float>(o.scale.width);
+    h.hand_scale[2] = static_cast<float>(o.scale.sigma);
   }
 }
 

@@ -27,7 +27,7 @@ void PublishStage::step(const Frame& f) {
   p.grab_ms = ms_between(f.capture_ns, f.grab_end_ns);
   p.preprocess_ms = ms_between(f.preprocess_start_ns, f.preprocess_end_ns);
   p.optimize_ms = ms_between(f.optimize_start_ns, f.optimize_end_ns);
-  fill_hands(f.output, f.scale, p);
+  fill_hands(f.output, p);
   // publish_ms: from the end of optimization to the record going out (hand-over + filling).
   p.publish_ms = ms_between(f.optimize_end_ns, monotonic_ns());
   ring_.publish(p);

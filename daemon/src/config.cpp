@@ -191,6 +191,10 @@ const std::vector<Field>& fields() {
     {"tracker.hand_profile", StringRef{[](DaemonConfig& c) -> std::string& { return c.hand_profile; }}, 0, 4096,
      "hand profile file (handtrack-calibrate, Sec. 6): its scales replace tracker.scale; empty: tracker.scale",
      false},
+    {"tracker.self_calibrate", BoolRef{[](DaemonConfig& c) -> bool& { return c.tracker.self_calibrate; }}, 0, 0,
+     "true: each hand in view is calibrated from its first frames held open toward the camera and then tracked with "
+     "the scale found (from tracker.scale or the hand profile); false: tracker.scale (or the profile) throughout",
+     false},
     {"tracker.seed", Uint64Ref{[](DaemonConfig& c) -> uint64_t& { return c.tracker.seed; }}, 0, kMaxSeed,
      "random seed of the particle extrapolation", true},
     // [tracker.input] (Sec. 3.1, Sec. 4)

@@ -10,6 +10,7 @@
 // (L, W) is {length L, width W, sigma W}.
 #include "handtrack/core/hand_calibration.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
+#include "synthetic_tracking.hpp"
 
 #include <gtest/gtest.h>
 
@@ -121,6 +122,84 @@ TEST(HandCalibration, RecoversSyntheticSubjectsScale) {
     EXPECT_NEAR(r.scale.width, subject.width, kTolerance * subject.width);
     EXPECT_NEAR(r.scale.sigma, subject.width, kTolerance * subject.width);
   }
+}
+
+// Self-calibration (TrackerConfig::self_calibrate, core/src/self_calibration.hpp): a hand 15 % smaller
+// than the default model, tracked by a Tracker as handtrackd tracks (no profile, no offline step).
+struct Tracked {
+  HandScale scale;           // the tracker's after the last frame
+  HandScale reported;        // TrackerOutput::scale of the last frame
+  double late_error_mm = 0;  // mean fingertip error over the second half of the frames
+};
+
+Tracked track_subject(const synth::SubjectScale& subject, synth::View view, TrackerConfig config,
+                      const char* motion = "adbadd") {
+  synth::SynthOptions options;
+  options.motion = motion;
+  options.view = view;
+  options.frames = 160;
+  options.seed = 11;
+  options.subject = subject;
+  synth::SyntheticCamera camera(options);
+  Tracker tracker(config);
+  synth::SynthFrame frame;
+  Tracked t;
+  int scored = 0;
+  for (int i = 0; i < options.frames; ++i) {
+    camera.render(i, frame);
+    const auto out = tracker.track(frame.depth, &testing::shipped_forest());
+    tracker.wait_for_checks();  // background: as if the camera waited for the idle CPU
+    t.reported = out.scale;
+    if (i < options.frames / 2 || out.state == TrackingState::kNoHand) continue;
+    for (int f = 0; f < kNumFingers; ++f) {
+      t.late_error_mm += (out.fingertips[static_cast<size_t>(f)] - *frame.fingertips[static_cast<size_t>(f)]).norm();
+    }
+    scored += kNumFingers;
+  }
+  t.scale = tracker.config().scale;
+  t.late_error_mm = scored > 0 ? t.late_error_mm / scored : 1e9;
+  return t;
+}
+
+void expect_scale_of(const HandScale& found, const synth::SubjectScale& subject) {
+  EXPECT_NEAR(found.length, subject.length, kTolerance * subject.length);
+  EXPECT_NEAR(found.width, subject.width, kTolerance * subject.width);
+  EXPECT_NEAR(found.sigma, subject.width, kTolerance * subject.width);
+}
+
+constexpr synth::SubjectScale kSmallHand{0.85, 0.85};
+
+// The shipped configuration: late fusion with the shipped forest.
+TrackerConfig shipped(bool self_calibrate) {
+  TrackerConfig config = testing::paper_config(EnergyMode::kLateFusion);
+  config.self_calibrate = self_calibrate;
+  return config;
+}
+
+TEST(SelfCalibration, ASmallHandIsTrackedWithItsOwnScaleAndBetter) {
+  const Tracked before = track_subject(kSmallHand, synth::View::kPalm, shipped(false));
+  const Tracked after = track_subject(kSmallHand, synth::View::kPalm, shipped(true));
+  std::printf("  fixed scale %.2f mm, calibrated to %.3f,%.3f,%.3f: %.2f mm\n", before.late_error_mm,
+              after.scale.length, after.scale.width, after.scale.sigma, after.late_error_mm);
+  EXPECT_EQ(before.scale, HandScale{});
+  expect_scale_of(after.scale, kSmallHand);
+  EXPECT_EQ(after.reported, after.scale);  // what the ring's hand_scale carries
+  EXPECT_LT(after.late_error_mm, before.late_error_mm - 2.0);  // measured: 17.6 -> 13.2 mm
+}
+
+TEST(SelfCalibration, RunsInTheBackgroundAsHandtrackdRunsIt) {
+  TrackerConfig config = shipped(true);
+  config.background_checks = true;
+  const Tracked t = track_subject(kSmallHand, synth::View::kPalm, config);
+  expect_scale_of(t.scale, kSmallHand);
+}
+
+// A hand seen edge-on shows its length but not its width: its frames are not calibrated on, and the
+// scale stays (calibrated on every tracked frame, the side view found widths at the bottom of the
+// search's range).
+TEST(SelfCalibration, AHandSeenEdgeOnKeepsItsScale) {
+  const Tracked t = track_subject(kSmallHand, synth::View::kSide, shipped(true));
+  EXPECT_EQ(t.scale, HandScale{});
 }
 
 }  // namespace

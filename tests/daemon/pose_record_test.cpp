@@ -30,7 +30,7 @@ TEST(PoseRecordSeam, EveryTrackingStateKeepsItsMeaning) {
   TrackerOutput o;
   o.state = TrackingState::kRecovering;
   o.hand_id = 3;
-  fill_hands(one_hand(o), HandScale{}, r);
+  fill_hands(one_hand(o), r);
   ASSERT_EQ(r.hand_count, 1U);
   EXPECT_EQ(r.hands[0].state, HANDTRACK_STATE_RECOVERING);
 }
@@ -46,7 +46,7 @@ TEST(PoseRecordSeam, EveryHandednessKeepsItsMeaning) {
     o.hand_id = 1;
     o.handedness = hand;
     ipc::FrameRecord r{};
-    fill_hands(one_hand(o), HandScale{}, r);
+    fill_hands(one_hand(o), r);
     EXPECT_EQ(r.hands[0].handedness, code) << to_string(hand);
   }
 }
@@ -56,9 +56,9 @@ TEST(PoseRecordSeam, NoHandIsAFrameWithoutHands) {
   TrackerOutput tracked;
   tracked.state = TrackingState::kTracking;
   tracked.hand_id = 4;
-  fill_hands(one_hand(tracked), HandScale{}, r);  // the record is reused frame after frame
+  fill_hands(one_hand(tracked), r);  // the record is reused frame after frame
   ASSERT_EQ(r.hand_count, 1U);
-  fill_hands(HandsOutput{}, HandScale{}, r);
+  fill_hands(HandsOutput{}, r);
   EXPECT_EQ(r.hand_count, 0U);
   EXPECT_EQ(r.hands[0].hand_id, 0U) << "the lost hand's record is cleared";
   EXPECT_EQ(r.hands[0].state, HANDTRACK_STATE_NO_HAND);
@@ -79,10 +79,10 @@ TEST(PoseRecordSeam, EveryValueLandsInItsField) {
   o.confidence = 0.75;
   o.pinch_distance_mm = 21;
   o.pinch_strength = 0.25;
-  const HandScale scale{.length = 1.1, .width = 0.9, .sigma = 1.05};
+  o.scale = {.length = 1.1, .width = 0.9, .sigma = 1.05};  // its own (self-calibration)
   ipc::FrameRecord r{};
   r.frame = 77;  // the publisher's fields are left alone
-  fill_hands(one_hand(o, 2.5), scale, r);
+  fill_hands(one_hand(o, 2.5), r);
   EXPECT_EQ(r.frame, 77U);
   ASSERT_EQ(r.hand_count, 1U);
   const ipc::HandRecord& h = r.hands[0];
@@ -125,7 +125,7 @@ TEST(PoseRecordSeam, TwoHandsAreTwoRecordsEachWithItsOwnTimes) {
   out.hands[1].handedness = Handedness::kLeft;
   out.optimize_ms = {1.5, 2.25};
   ipc::FrameRecord r{};
-  fill_hands(out, HandScale{}, r);
+  fill_hands(out, r);
   ASSERT_EQ(r.hand_count, 2U);
   EXPECT_EQ(r.hands[0].hand_id, 5U);
   EXPECT_EQ(r.hands[0].handedness, HANDTRACK_HANDEDNESS_RIGHT);

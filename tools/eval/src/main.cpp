@@ -165,6 +165,18 @@ struct FrameLoop {
   std::ostream* tips = nullptr;                   // non-null: --tips-csv
   std::ostream* joints = nullptr;                 // non-null: --joints-csv
   SharedProgress* progress = nullptr;
+  const SequenceReader* warm_up = nullptr;        // non-null: --warm-up
+
+  // --warm-up: every frame of that sequence tracked first, unscored, then one frame without a hand
+  // (the hand has left), so that the scored sequence is a hand seen again in a session.
+  template <typename Track>
+  void run_warm_up(Track&& track) const {
+    if (warm_up == nullptr) return;
+    for (size_t i = 0; i < warm_up->frame_count(); ++i) track(warm_up->depth(i));
+    DepthImage empty = warm_up->depth(0);
+    std::fill(empty.depth_mm.begin(), empty.depth_mm.end(), 0.0F);
+    track(empty);
+  }
 
   // Tracks every frame of `reader` with track(depth) (timed) and hands its output to
   // score(i, output); returns the seconds spent tracking.
@@ -198,6 +210,7 @@ eval::SequenceScore evaluate_one_hand(const SequenceReader& reader, const Sequen
     none.state = TrackingState::kNoHand;
     return out.count > 0 ? out.hands[0] : none;
   };
+  loop.run_warm_up(track);
   const double seconds = loop.run(
       reader, track,
       [&](size_t i, const TrackerOutput& out) {
@@ -221,8 +234,10 @@ eval::SequenceScore evaluate_hands(const SequenceReader& reader, const SequenceI
   eval::HandsScorer scorer(name, info.hands);
   std::vector<Fingertips> truth(info.hands.size());
   std::vector<std::optional<Joints>> joints(info.hands.size());
+  const auto track = [&](const DepthImage& depth) { return tracker.track(depth, loop.labeller); };
+  loop.run_warm_up(track);
   const double seconds = loop.run(
-      reader, [&](const DepthImage& depth) { return tracker.track(depth, loop.labeller); },
+      reader, track,
       [&](size_t i, const HandsOutput& out) {
         for (size_t k = 0; k < truth.size(); ++k) {
           truth[k] = reader.fingertips(i, static_cast<int>(k));
@@ -303,6 +318,16 @@ int main(int argc, char** argv) {
                "late fusion with the sequence's ground-truth labels/ instead of the forest (diagnosis)");
   std::string hand_profile;
   app.add_option("--hand-profile", hand_profile, "hand profile (handtrack-calibrate): the user's hand scale (Sec. 6)");
+  app.add_option("--self-calibrate", config.self_calibrate,
+                 "on (default): each hand is calibrated from its first confidently tracked frames and then tracked with "
+                 "the scale found (Sec. 6 made online; docs/TRACKER.md, \"Hands of other sizes\"); off: the default "
+                 "model's scale (or --hand-profile's) throughout");
+  std::string warm_up;
+  app.add_option("--warm-up", warm_up,
+                 "a sequence each tracker sees first, unscored, then a frame without a hand: every scored sequence a "
+                 "hand seen again in a session (self-calibration keeps the scale it found; docs/TRACKER.md, \"A hand "
+                 "calibrates itself\")")
+      ->check(CLI::ExistingDirectory);
   app.add_option("--recheck-frames", config.recheck_interval_frames,
                  "recheck a fit whose running confidence is below recheck_below_confidence (0.8) every N frames "
                  "(default 30; 0: never; docs/TRACKER.md, \"Rechecks of a mediocre fit\")")
@@ -356,6 +381,9 @@ int main(int argc, char** argv) {
 
   try {
     if (!hand_profile.empty()) config.scale = load_hand_profile(hand_profile);
+    if (!warm_up.empty() && oracle_labels) throw std::runtime_error("--warm-up: not with --oracle-labels");
+    std::optional<SequenceReader> warm_up_reader;
+    if (!warm_up.empty()) warm_up_reader.emplace(warm_up);
     std::optional<PartForest> forest;
     if (config.mode == EnergyMode::kLateFusion && !oracle_labels) forest.emplace(PartForest::load(forest_file));
     const bool use_oracle_labels = config.mode == EnergyMode::kLateFusion && oracle_labels;
@@ -407,6 +435,7 @@ int main(int argc, char** argv) {
       loop.labeller = use_oracle_labels ? &oracle : forest ? static_cast<const PixelLabeller*>(&*forest) : nullptr;
       loop.oracle_labels = use_oracle_labels ? &truth_labels : nullptr;
       loop.progress = &progress;
+      loop.warm_up = warm_up_reader ? &*warm_up_reader : nullptr;
       for (size_t i = next_sequence++; i < readers.size(); i = next_sequence++) {
         std::ostringstream tips;
         std::ostringstream joints;

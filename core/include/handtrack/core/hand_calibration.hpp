@@ -89,6 +89,8 @@ class CalibrationSet {
   // Offers one tracked frame: its depth, the tracker's output and the hint the tracker gives after
   // it (PoseTracker::hint()). Returns whether it was kept.
   bool offer(const DepthImage& depth, const TrackerOutput& tracked, const std::optional<HandHint>& hint);
+  // Forgets the frames kept (another hand's frames come next).
+  void clear();
   [[nodiscard]] bool full() const { return static_cast<int>(inputs_.size()) >= options_.max_frames; }
   [[nodiscard]] int size() const { return static_cast<int>(inputs_.size()); }
   // Views into this set: valid while it lives and is not offered more frames.

@@ -159,6 +159,9 @@ struct TrackerConfig {
   // unreported, for this many frames: where it shows again near its last pose it is the same hand
   // (HandsTracker).
   int hidden_hand_frames = 20;
+  // Each hand that comes into view is calibrated from its first confidently tracked frames, and
+  // then tracked with the scale found (Tracker; src/self_calibration.hpp). false: `scale` always.
+  bool self_calibrate = true;
   uint64_t seed = 1;
 };
 
@@ -209,11 +212,14 @@ struct TrackerOutput {
   // "recovering" frames and a change of the chosen hand) and is new each time a hand appears after
   // a frame without one; 0 when there is no hand. Counts from 1 within one Tracker.
   uint32_t hand_id = 0;
+  // The hand model's scale this pose is of (TrackerConfig::scale, or what self-calibration found).
+  HandScale scale;
   // fit_score() of this pose (below).
   [[nodiscard]] double score() const;
 };
 
 class BackgroundSearch;
+class SelfCalibration;
 
 class PoseTracker {
  public:
@@ -312,6 +318,9 @@ class PoseTracker {
 // Background checks' searches that have finished (TrackerConfig::background_checks), in this
 // process, dropped ones included: a statistic, and how tests see that the search thread ran.
 uint64_t background_searches_finished();
+// Hands' self-calibrations (TrackerConfig::self_calibrate) whose scale was taken, in this process:
+// how tests see that a hand was calibrated.
+uint64_t self_calibrations_taken();
 
 // What the next frame's preprocessing should build for a Tracker: the inputs of the hands it will
 // fit, each with its segmentation hint (the mirrored frame's hint for the left hand).
@@ -369,6 +378,9 @@ class TrackerInputs {
 class Tracker {
  public:
   explicit Tracker(const TrackerConfig& config = {});
+  ~Tracker();
+  Tracker(Tracker&&) noexcept;
+  Tracker& operator=(Tracker&&) noexcept;
   // What the next frame needs: both hands at a (re)start in auto mode, else the current one.
   [[nodiscard]] InputRequest request() const;
   // Fits the hand(s) on inputs built for request() (or for an older request: a hand whose input
@@ -391,6 +403,7 @@ class Tracker {
   void set_other_hand(const HandObstacle* as_right, const HandObstacle* as_left) {
     right_.set_other_hand(as_right);
     left_.set_other_hand(as_left);
+    beside_other_ = as_right != nullptr || as_left != nullptr;
   }
   // Which hand this one probably is (HandsTracker: not the other hand in view, or, while neither
   // hand's side has been told, the one its place in the image says), for choices within
@@ -406,12 +419,9 @@ class Tracker {
   // Carry on from `last` (a pose this tracker reported) at the next frame, as if it had just been
   // tracked: HandsTracker's way back for a hand hidden behind the other, instead of a (re)start.
   void resume(const TrackerOutput& last);
-  // With background checks: blocks until both hands' checks under way have finished
-  // (PoseTracker::wait_for_check; tests).
-  void wait_for_checks() {
-    right_.wait_for_check();
-    left_.wait_for_check();
-  }
+  // With background checks: blocks until both hands' checks and the self-calibration under way
+  // have finished (PoseTracker::wait_for_check; tests).
+  void wait_for_checks();
 
  private:
   [[nodiscard]] const PoseTracker& side(Handedness hand) const { return hand == Handedness::kLeft ? left_ : right_; }
@@ -429,6 +439,9 @@ class Tracker {
   void weigh(const TrackerOutput& as_right, const TrackerOutput& as_left);
   TrackerOutput fit(Handedness hand, const DepthInput& input);
   void identify(TrackerOutput& out);  // sets out.hand_id
+  // Offers the frame to the hand's self-calibration (TrackerConfig::self_calibrate) and takes the
+  // scale it finds.
+  void calibrate(const TrackerInputs& inputs, const TrackerOutput& out);
 
   PoseTracker right_;
   PoseTracker left_;
@@ -452,6 +465,8 @@ class Tracker {
   int frames_since_trial_ = 0;
   uint32_t hand_id_ = 0;   // of the hand in view; 0: none in the last frame
   uint32_t last_hand_id_ = 0;
+  bool beside_other_ = false;  // set_other_hand(): another hand in view
+  std::unique_ptr<SelfCalibration> calibration_;  // null: TrackerConfig::self_calibrate off
 };
 
 }  // namespace handtrack

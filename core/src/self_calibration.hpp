@@ -1,0 +1,71 @@
+#pragma once
+// SelfCalibration: the user's hand scale found while tracking (ours; Sec. 6's calibration made
+// online). The paper calibrates each user once, offline, from a sequence of the hand held open;
+// handtrack-calibrate does that. A user who never runs it is tracked with the default adult hand,
+// and hands 15 % smaller or 20 % longer than it lose 4-9 mm at the fingertips (docs/TRACKER.md,
+// "Hands of other sizes"). So each hand that comes into view is calibrated from its own
+// confidently tracked frames (CalibrationSet: 12 frames, one every 5), by the same greedy search
+// (calibrate_hand_scale) from the scale it is tracked with, and then tracked with the scale found.
+//
+// Only frames that show the hand's size serve: the hand open and facing the camera (palm or back).
+// Calibrated from every tracked frame, the side view found every hand's width at the bottom of the
+// search's range and the head-mounted view likewise, fists their length, and the benchmark's own
+// subjects lost 1.2 mm (docs/TRACKER.md, "A hand calibrates itself").
+//
+// The search takes about 0.4 s. With TrackerConfig::background_checks (handtrackd's default) it
+// runs on a thread of its own at the lowest priority (idle_thread.hpp) and its scale is taken at
+// the first frame after it finishes; otherwise on the frame that completes the set, so that every
+// run of handtrack-eval is the same.
+//
+// Thread roles: offer() and wait() from the tracking thread; the search on the calibration thread.
+// They hand the set over through one atomic state, without a lock (as BackgroundSearch does, for
+// the same reason: a SCHED_IDLE thread holding a lock could hold it as long as the machine is busy).
+#include "handtrack/core/hand_calibration.hpp"
+#include "handtrack/core/tracker.hpp"
+
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <thread>
+
+namespace handtrack {
+
+class SelfCalibration {
+ public:
+  explicit SelfCalibration(const TrackerConfig& config);
+  ~SelfCalibration();  // waits for a search under way
+  SelfCalibration(const SelfCalibration&) = delete;
+  SelfCalibration& operator=(const SelfCalibration&) = delete;
+
+  // Offers one tracked frame of the hand: its input (the frame it was fitted on, in the fitting
+  // tracker's frame: a left hand's is mirrored), the tracker's output in that frame, and the hint
+  // the tracker gives after it. Returns the hand's scale once it is found, once per hand
+  // (TrackerOutput::hand_id: a new hand in view is calibrated afresh, from `current`; a search
+  // that finishes after its hand has left is dropped).
+  std::optional<HandScale> offer(const DepthInput& input, const TrackerOutput& tracked,
+                                 const std::optional<HandHint>& hint, const HandScale& current);
+  // Blocks until the search under way (if any) has finished (tests).
+  void wait();
+
+ private:
+  // kGathering -> kQueued (offer: the set is full) -> kRunning (the calibration thread) -> kDone
+  // -> kGathering (offer takes the scale); any -> kStop (the destructor). Each store that hands
+  // data over is a release, each load that takes it an acquire.
+  enum class State { kGathering, kQueued, kRunning, kDone, kStop };
+  void run();  // the calibration thread
+  // The search on the set, from from_ (either thread, while it owns the set).
+  [[nodiscard]] HandScale search() const;
+
+  TrackerConfig config_;   // calibration_tracker_config()
+  // Owned by the tracking thread while gathering, by the calibration thread while queued or running.
+  CalibrationSet set_;
+  HandScale from_;
+  HandScale found_;        // written while running, read once done
+  DepthImage frame_;       // the offered input's filtered depth, segmented anew by the set
+  uint32_t hand_id_ = 0;   // of the hand the set is of
+  bool gathered_ = false;  // the set of this hand is complete (searched or being searched)
+  std::atomic<State> state_{State::kGathering};
+  std::thread thread_;     // last; only with TrackerConfig::background_checks
+};
+
+}  // namespace handtrack
