@@ -11,7 +11,7 @@ std::atomic<uint64_t> finished_searches{0};
 uint64_t background_searches_finished() { return finished_searches.load(std::memory_order_relaxed); }
 
 BackgroundSearch::BackgroundSearch(const TrackerConfig& config)
-    : search_(config), scale_(config.scale), thread_([this] { run(); }) {
+    : search_(config), thread_([this] { run(); }) {
   // Room for the other hand: a model's Gaussians (submit() copies one of the same size). The search
   // thread reads other_ only once a search is queued.
   other_.assign(search_.model(), PosedHand(search_.model(), PoseParams::Zero()), false);
@@ -35,13 +35,13 @@ void BackgroundSearch::reserve(int width, int height) {
   if (state_.load(std::memory_order_acquire) == State::kIdle) reserve_input(input_, width, height);
 }
 
-bool BackgroundSearch::submit(const DepthInput& input, const HandObstacle* other, const HandScale& scale) {
+bool BackgroundSearch::submit(const DepthInput& input, const HandObstacle* other, const HandModel& model) {
   reclaim_dropped();
   if (state_.load(std::memory_order_acquire) != State::kIdle) return false;
   input_ = input;  // into the room reserve() made: no allocation
   has_other_ = other != nullptr;
   if (has_other_) other_ = *other;
-  scale_ = scale;
+  search_.set_model(model);  // a self-calibrated scale (tracker.cpp)
   wanted_ = true;
   state_.store(State::kQueued, std::memory_order_release);
   state_.notify_all();
@@ -85,8 +85,7 @@ void BackgroundSearch::run() {
     if (s == State::kStop) return;
     // Cancelled (back to idle) or stopped meanwhile: nothing to search.
     if (!state_.compare_exchange_strong(s, State::kRunning, std::memory_order_acq_rel)) continue;
-    // input_, other_ and scale_ stay as submit() left them until the state is idle again.
-    search_.set_scale(scale_);
+    // input_, other_ and the model stay as submit() left them until the state is idle again.
     search_.set_other_hand(has_other_ ? &other_ : nullptr);
     result_ = search_.run(input_, SearchPurpose::kCheck, &stop_);
     search_.take_iterations();  // the tracking thread counts its own iterations only

@@ -33,9 +33,10 @@ class BackgroundSearch {
   // Room for copies of inputs of a width x height image, so that submit() allocates nothing (as
   // the daemon's steady state requires); none made while a search reads the copy.
   void reserve(int width, int height);
-  // Starts a search on copies of `input` and `other` (null: no other hand) with the hand model at
-  // `scale`; false, and nothing started, while a search is under way or its result is not taken.
-  bool submit(const DepthInput& input, const HandObstacle* other, const HandScale& scale);
+  // Starts a search on copies of `input` and `other` (null: no other hand) with `model` (the
+  // tracker's, a default adult at its scale: copied without allocating); false, and nothing
+  // started, while a search is under way or its result is not taken.
+  bool submit(const DepthInput& input, const HandObstacle* other, const HandModel& model);
   // The finished search's best fit, once; nullopt while it runs, when none was submitted, or when
   // it was cancelled.
   std::optional<StartFit> take();
@@ -61,7 +62,6 @@ class BackgroundSearch {
   DepthInput input_;
   HandObstacle other_;
   bool has_other_ = false;
-  HandScale scale_;
   StartFit result_;  // written while running, read once done
   std::thread thread_;  // last: started once everything it reads is constructed
 };

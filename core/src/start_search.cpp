@@ -103,6 +103,12 @@ void StartSearch::set_scale(const HandScale& scale) {
   model_ = HandModel::default_adult(scale);
 }
 
+void StartSearch::set_model(const HandModel& model) {
+  if (model.scale() == scale_) return;
+  scale_ = model.scale();
+  model_ = model;  // vectors of the same sizes: copied into their storage
+}
+
 
 StartHypothesis StartSearch::hypothesis(const HandPlace& place, size_t k) {
   // Hypothesis k: by plane (the image's, then along the 3D axis), turn, closed, and in-plane

@@ -616,7 +616,7 @@ PoseTracker::CheckOutcome PoseTracker::background_check(const DepthInput& input,
     // The search runs on copies of this frame's input (segmented afresh: hint()) and of the other
     // hand as it is now; while the last search's result is still under way (a cancelled one
     // finishing) the check waits for the next frame.
-    if (!background_->submit(input, other_hand_, config_.scale)) return CheckOutcome::kNone;
+    if (!background_->submit(input, other_hand_, model())) return CheckOutcome::kNone;
     check_ = Check{true, next_check_, {}, input.hand_centroid_mm, 0, 0, 0, tracked};
     next_check_ = CheckCause::kNone;
     return CheckOutcome::kChecking;

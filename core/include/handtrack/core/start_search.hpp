@@ -77,6 +77,9 @@ class StartSearch {
 
   explicit StartSearch(const TrackerConfig& config);
   void set_scale(const HandScale& scale);
+  // The model of another search of the same structure (a default adult at another scale): copied
+  // into this one's storage, without allocating, where its scale differs.
+  void set_model(const HandModel& model);
   // Another hand in the frame that the fits must not enter; null: none. It must outlive the
   // searches that use it.
   void set_other_hand(const HandObstacle* other) { other_hand_ = other; }
