@@ -45,7 +45,9 @@ SelfCalibration::~SelfCalibration() {
 HandScale SelfCalibration::search() const {
   TrackerConfig from = config_;
   from.scale = from_;
-  return calibrate_hand_scale(set_.frames(), from).scale;
+  HandScale found = from_;
+  found.length = calibrate_hand_scale(set_.frames(), from).scale.length;
+  return found;
 }
 
 std::optional<HandScale> SelfCalibration::offer(const DepthInput& input, const TrackerOutput& tracked,
