@@ -319,8 +319,8 @@ int main(int argc, char** argv) {
   std::string hand_profile;
   app.add_option("--hand-profile", hand_profile, "hand profile (handtrack-calibrate): the user's hand scale (Sec. 6)");
   app.add_option("--self-calibrate", config.self_calibrate,
-                 "on (default): each hand is calibrated from its first confidently tracked frames and then tracked with "
-                 "the scale found (Sec. 6 made online; docs/TRACKER.md, \"Hands of other sizes\"); off: the default "
+                 "on (default): each hand's length is calibrated from its frames held open toward the camera and then "
+                 "tracked with (Sec. 6 made online; docs/TRACKER.md, \"A hand calibrates itself\"); off: the default "
                  "model's scale (or --hand-profile's) throughout");
   std::string warm_up;
   app.add_option("--warm-up", warm_up,

@@ -159,8 +159,8 @@ struct TrackerConfig {
   // unreported, for this many frames: where it shows again near its last pose it is the same hand
   // (HandsTracker).
   int hidden_hand_frames = 20;
-  // Each hand that comes into view is calibrated from its first confidently tracked frames, and
-  // then tracked with the scale found (Tracker; src/self_calibration.hpp). false: `scale` always.
+  // Each hand that comes into view has its length calibrated from its frames held open toward the
+  // camera, and is then tracked with it (Tracker; src/self_calibration.hpp). false: `scale` always.
   bool self_calibrate = true;
   uint64_t seed = 1;
 };
