@@ -1,25 +1,17 @@
 #pragma once
-// BackgroundSearch: a check's (re)start search (StartSearch::run) on a thread of its own, at the
-// lowest scheduling priority, on copies of the check's first frame and of the other hand as it was
-// then (TrackerConfig::background_checks). The tracking thread hands a search over and takes its
-// result at a later frame; it never waits for one (except wait(), for tests).
-//
-// The thread runs under SCHED_IDLE on every CPU: it gets only time that no other thread of the
-// machine wants, so a pipeline thread that wakes preempts it at once, and a search takes as long
-// as the idle CPU allows. It starts with the object, so that a tracker's threads are the same from
-// its first frame to its last (a daemon's thread count says nothing leaked).
+// BackgroundSearch: a check's (re)start search (StartSearch::run) on a worker thread of its own at
+// the lowest scheduling priority (IdleWorker), on copies of the check's first frame and of the other
+// hand as it was then (TrackerConfig::background_checks). The tracking thread hands a search over
+// and takes its result at a later frame; it never waits for one (except wait(), for tests).
 //
 // Thread roles: reserve(), submit(), take(), cancel() and wait() from the tracking thread (one at a
-// time); the search itself on the search thread. The two share no lock: they hand the search over
-// through one atomic state, so a tracking thread never waits for a thread that may not run for as
-// long as the machine is busy (a SCHED_IDLE thread preempted while holding a lock would hold it
-// that long: priority inversion).
+// time); the search itself on the worker.
+#include "idle_worker.hpp"
 #include "handtrack/core/start_search.hpp"
 #include "handtrack/core/tracker.hpp"
 
 #include <atomic>
 #include <optional>
-#include <thread>
 
 namespace handtrack {
 
@@ -46,24 +38,19 @@ class BackgroundSearch {
   void wait();
 
  private:
-  // kIdle -> kQueued (submit) -> kRunning (the search thread) -> kDone -> kIdle (take, or submit
-  // after a cancel); kQueued -> kIdle (cancel); any -> kStop (the destructor). Each store that hands
-  // data over is a release, each load that takes it an acquire.
-  enum class State { kIdle, kQueued, kRunning, kDone, kStop };
-  void run();  // the search thread
+  void search();  // the worker's job
   // Finished and unwanted: back to idle (tracking thread).
   void reclaim_dropped();
 
-  std::atomic<State> state_{State::kIdle};
   std::atomic<bool> stop_{false};  // the destructor: the search stops at its next hypothesis
   bool wanted_ = false;            // tracking thread: the search submitted is to be taken
-  // Written by the tracking thread while idle, read by the search thread while running.
+  // Written by the tracking thread while the worker is idle, read by it while it runs.
   StartSearch search_;
   DepthInput input_;
   HandObstacle other_;
   bool has_other_ = false;
   StartFit result_;  // written while running, read once done
-  std::thread thread_;  // last: started once everything it reads is constructed
+  IdleWorker worker_;  // last: its thread starts once everything it reads is constructed
 };
 
 }  // namespace handtrack

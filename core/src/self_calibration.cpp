@@ -1,7 +1,6 @@
 #include "self_calibration.hpp"
 
-#include "idle_thread.hpp"
-
+#include <atomic>
 #include <cmath>
 
 namespace handtrack {
@@ -32,85 +31,61 @@ uint64_t self_calibrations_taken() { return calibrations_taken.load(std::memory_
 
 SelfCalibration::SelfCalibration(const TrackerConfig& config)
     : config_(calibration_tracker_config(config)), set_(CalibrationSet::Options{}, input_config(config)) {
-  if (config.background_checks) thread_ = std::thread([this] { run(); });
+  if (config.background_checks) worker_.emplace("ht-calibrate", [this] { search(); });
 }
 
-SelfCalibration::~SelfCalibration() {
-  if (!thread_.joinable()) return;
-  state_.store(State::kStop, std::memory_order_release);
-  state_.notify_all();
-  join_from_idle_class(thread_);  // a search under way finishes first
-}
-
-HandScale SelfCalibration::search() const {
+void SelfCalibration::search() {
   TrackerConfig from = config_;
   from.scale = from_;
-  HandScale found = from_;
-  found.length = calibrate_hand_scale(set_.frames(), from).scale.length;
-  return found;
+  // The length only (self_calibration.hpp).
+  found_ = from_;
+  found_.length = calibrate_hand_scale(set_.frames(), from).scale.length;
 }
 
 std::optional<HandScale> SelfCalibration::offer(const DepthInput& input, const TrackerOutput& tracked,
                                                 const std::optional<HandHint>& hint, const HandScale& current) {
   std::optional<HandScale> found;
-  switch (state_.load(std::memory_order_acquire)) {
-    case State::kQueued:
-    case State::kRunning:
-    case State::kStop:
-      return std::nullopt;
-    case State::kDone:
-      if (tracked.hand_id == hand_id_) {
-        found = found_;
-        calibrations_taken.fetch_add(1, std::memory_order_relaxed);
-      }
-      state_.store(State::kGathering, std::memory_order_relaxed);
-      break;
-    case State::kGathering:
-      break;
+  if (worker_) {
+    switch (worker_->state()) {
+      case IdleWorker::State::kQueued:
+      case IdleWorker::State::kRunning:
+      case IdleWorker::State::kStop:
+        return std::nullopt;
+      case IdleWorker::State::kDone:
+        if (tracked.hand_id == hand_id_) found = found_;  // else its hand has left: dropped
+        worker_->finish();
+        break;
+      case IdleWorker::State::kIdle:
+        break;
+    }
   }
   if (tracked.hand_id != hand_id_) {
     hand_id_ = tracked.hand_id;
     set_.clear();
     gathered_ = false;
   }
-  if (found || gathered_ || !shows_its_size(tracked)) return found;
-  frame_.camera = input.camera;
-  frame_.mirrored = input.mirrored;
-  frame_.depth_mm = input.filtered_mm;
-  set_.offer(frame_, tracked, hint);
-  if (!set_.full()) return std::nullopt;
-  gathered_ = true;
-  from_ = current;
-  if (!thread_.joinable()) {
-    calibrations_taken.fetch_add(1, std::memory_order_relaxed);
-    return search();
+  if (!found && !gathered_ && shows_its_size(tracked)) {
+    frame_.camera = input.camera;
+    frame_.mirrored = input.mirrored;
+    frame_.depth_mm = input.filtered_mm;
+    set_.offer(frame_, tracked, hint);
+    if (set_.full()) {
+      gathered_ = true;
+      from_ = current;
+      if (worker_) {
+        worker_->submit();
+      } else {
+        search();
+        found = found_;
+      }
+    }
   }
-  state_.store(State::kQueued, std::memory_order_release);
-  state_.notify_all();
-  return std::nullopt;
+  if (found) calibrations_taken.fetch_add(1, std::memory_order_relaxed);
+  return found;
 }
 
 void SelfCalibration::wait() {
-  for (State s = state_.load(std::memory_order_acquire); s == State::kQueued || s == State::kRunning;
-       s = state_.load(std::memory_order_acquire)) {
-    state_.wait(s, std::memory_order_acquire);
-  }
-}
-
-void SelfCalibration::run() {
-  become_idle_class("ht-calibrate");
-  for (;;) {
-    State s = state_.load(std::memory_order_acquire);
-    while (s != State::kQueued && s != State::kStop) {
-      state_.wait(s, std::memory_order_acquire);
-      s = state_.load(std::memory_order_acquire);
-    }
-    if (s == State::kStop) return;
-    if (!state_.compare_exchange_strong(s, State::kRunning, std::memory_order_acq_rel)) continue;  // stopped
-    found_ = search();
-    State running = State::kRunning;
-    if (state_.compare_exchange_strong(running, State::kDone, std::memory_order_acq_rel)) state_.notify_all();
-  }
+  if (worker_) worker_->wait();
 }
 
 }  // namespace handtrack

@@ -19,27 +19,24 @@
 // subjects lost 1.2 mm (docs/TRACKER.md, "A hand calibrates itself").
 //
 // The search takes about 0.4 s. With TrackerConfig::background_checks (handtrackd's default) it
-// runs on a thread of its own at the lowest priority (idle_thread.hpp) and its scale is taken at
+// runs on a worker thread of its own at the lowest priority (IdleWorker) and its scale is taken at
 // the first frame after it finishes; otherwise on the frame that completes the set, so that every
 // run of handtrack-eval is the same.
 //
-// Thread roles: offer() and wait() from the tracking thread; the search on the calibration thread.
-// They hand the set over through one atomic state, without a lock (as BackgroundSearch does, for
-// the same reason: a SCHED_IDLE thread holding a lock could hold it as long as the machine is busy).
+// Thread roles: offer() and wait() from the tracking thread; the search on the worker.
 #include "handtrack/core/hand_calibration.hpp"
 #include "handtrack/core/tracker.hpp"
 
-#include <atomic>
+#include "idle_worker.hpp"
+
 #include <cstdint>
 #include <optional>
-#include <thread>
 
 namespace handtrack {
 
 class SelfCalibration {
  public:
   explicit SelfCalibration(const TrackerConfig& config);
-  ~SelfCalibration();  // waits for a search under way
   SelfCalibration(const SelfCalibration&) = delete;
   SelfCalibration& operator=(const SelfCalibration&) = delete;
 
@@ -54,24 +51,18 @@ class SelfCalibration {
   void wait();
 
  private:
-  // kGathering -> kQueued (offer: the set is full) -> kRunning (the calibration thread) -> kDone
-  // -> kGathering (offer takes the scale); any -> kStop (the destructor). Each store that hands
-  // data over is a release, each load that takes it an acquire.
-  enum class State { kGathering, kQueued, kRunning, kDone, kStop };
-  void run();  // the calibration thread
-  // The search on the set, from from_ (either thread, while it owns the set).
-  [[nodiscard]] HandScale search() const;
+  // The search on the set, from from_ (on the frame, or as the worker's job).
+  void search();
 
   TrackerConfig config_;   // calibration_tracker_config()
-  // Owned by the tracking thread while gathering, by the calibration thread while queued or running.
+  // The tracking thread's while gathering, the worker's while it is queued or running.
   CalibrationSet set_;
   HandScale from_;
-  HandScale found_;        // written while running, read once done
+  HandScale found_;        // written by search(), read once it is done
   DepthImage frame_;       // the offered input's filtered depth, segmented anew by the set
   uint32_t hand_id_ = 0;   // of the hand the set is of
   bool gathered_ = false;  // the set of this hand is complete (searched or being searched)
-  std::atomic<State> state_{State::kGathering};
-  std::thread thread_;     // last; only with TrackerConfig::background_checks
+  std::optional<IdleWorker> worker_;  // last; only with TrackerConfig::background_checks
 };
 
 }  // namespace handtrack
