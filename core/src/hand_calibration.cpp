@@ -206,6 +206,7 @@ double fit_and_score(const std::vector<CalibrationFrame>& frames, const TrackerC
 
 TrackerConfig calibration_tracker_config(TrackerConfig config) {
   config.weights.smoothness = kPapersSmoothness;
+  config.self_calibrate = false;  // the frames' poses are of the one model the search starts from
   return config;
 }
 

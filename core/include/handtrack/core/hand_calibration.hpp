@@ -55,7 +55,8 @@ struct CalibrationResult {
 };
 
 // The configuration that tracks the frames a calibration is fitted on: `config` with the paper's
-// w_s (kPapersSmoothness) instead of the tracker's lighter default. Offline there is no lag to
+// w_s (kPapersSmoothness) instead of the tracker's lighter default, and without self-calibration
+// (a scale changed part-way would leave the frames' poses of two models). Offline there is no lag to
 // save, and the smoother poses are the better starts for the grid's re-fits: the seven subjects of
 // test_hand_calibration over three seeds, 2 of 63 scale estimates beyond 5 % with w_s = 1 and 5 with
 // 0.1 (mean error 1.98 against 2.25 %; docs/TRACKER.md, "w_s, the weight of E_smo").
