@@ -264,15 +264,20 @@ CalibrationResult calibrate_hand_scale(const std::vector<CalibrationFrame>& fram
 }
 
 bool CalibrationSet::offer(const DepthImage& depth, const TrackerOutput& tracked, const std::optional<HandHint>& hint) {
+  return due(tracked, hint) && keep(depth, tracked, *hint);
+}
+
+bool CalibrationSet::due(const TrackerOutput& tracked, const std::optional<HandHint>& hint) {
   // The first kept frame too comes `stride` frames into tracking: a (re)start's own pose, straight
   // from the hypothesis search, is not yet refined by tracking, and calibrating on it moved a 1.10
   // subject's length to 1.025 when the search changed (init_iterations 40 -> 80).
   ++since_kept_;
-  if (full() || !hint || tracked.state != TrackingState::kTracking || tracked.confidence < options_.min_confidence ||
-      since_kept_ < options_.stride) {
-    return false;
-  }
-  HandHint slack = *hint;
+  return !full() && hint && tracked.state == TrackingState::kTracking &&
+         tracked.confidence >= options_.min_confidence && since_kept_ >= options_.stride;
+}
+
+bool CalibrationSet::keep(const DepthImage& depth, const TrackerOutput& tracked, const HandHint& hint) {
+  HandHint slack = hint;
   slack.wrist_mm -= kWristSlackMm * slack.finger_axis;
   DepthInputConfig fine = input_config_;
   fine.quadtree_threshold_mm = kFineQuadtreeThresholdMm;

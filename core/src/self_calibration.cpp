@@ -64,11 +64,12 @@ std::optional<HandScale> SelfCalibration::offer(const DepthInput& input, const T
     set_.clear();
     gathered_ = false;
   }
-  if (!found && !gathered_ && shows_its_size(tracked)) {
+  // The frame's depth is copied only when the set wants it (one frame in `stride` at most).
+  if (!found && !gathered_ && shows_its_size(tracked) && set_.due(tracked, hint)) {
     frame_.camera = input.camera;
     frame_.mirrored = input.mirrored;
     frame_.depth_mm = input.filtered_mm;
-    set_.offer(frame_, tracked, hint);
+    set_.keep(frame_, tracked, *hint);
     if (set_.full()) {
       gathered_ = true;
       from_ = current;

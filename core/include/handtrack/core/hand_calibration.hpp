@@ -88,8 +88,13 @@ class CalibrationSet {
   CalibrationSet() : CalibrationSet(Options{}, DepthInputConfig{}) {}
 
   // Offers one tracked frame: its depth, the tracker's output and the hint the tracker gives after
-  // it (PoseTracker::hint()). Returns whether it was kept.
+  // it (PoseTracker::hint()). Returns whether it was kept. The same as due() and then keep().
   bool offer(const DepthImage& depth, const TrackerOutput& tracked, const std::optional<HandHint>& hint);
+  // The two halves of offer(), for a caller whose depth costs a copy: due() counts the frame and
+  // says whether the set wants it (a good fit, `stride` frames after the last kept one, the set not
+  // full); keep() then segments the depth of a frame that is due and keeps it if it shows a hand.
+  bool due(const TrackerOutput& tracked, const std::optional<HandHint>& hint);
+  bool keep(const DepthImage& depth, const TrackerOutput& tracked, const HandHint& hint);
   // Forgets the frames kept (another hand's frames come next).
   void clear();
   [[nodiscard]] bool full() const { return static_cast<int>(inputs_.size()) >= options_.max_frames; }
