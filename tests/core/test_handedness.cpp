@@ -76,8 +76,10 @@ INSTANTIATE_TEST_SUITE_P(
 // change to the model or the energy turns one or two easily (an earlier version: with late fusion
 // all but 230536/30, 90, 130 and 150; since the forest of 15,000 images and the once-split partial
 // leaves, 2026-11-28, all but 230536/170 and 231615/100, 200; and the same frame moved by one pixel
-// turns others: docs/TRACKER.md, "Real frames"). The bound: 3 of 4 depth-only, 2 of 3 with late
-// fusion; the goal is every frame.
+// turns others: docs/TRACKER.md, "Real frames"). Since the labels choose only among fits that
+// explain the depth about as well as the best (2026-11-30): with late fusion all of them, depth-only
+// all but 231615/200. The bound: 3 of 4 depth-only, 2 of 3 with late fusion; the goal is
+// every frame.
 struct RealCase {
   EnergyMode mode;
   int min_right_hands_of_12;  // of every 12 frames with a hand, at least this many right hands
@@ -159,6 +161,26 @@ INSTANTIATE_TEST_SUITE_P(DepthOnlyAndShipped, RealHands,
                            return std::string(c.param.mode == EnergyMode::kLateFusion ? "late_fusion" : "depth_only");
                          });
 
+// A real hand the forest mislabels: in SR305 frame 230536/130 (an open right hand, its fingers
+// toward the image's right, the thumb down) the forest calls most of the fingers "palm". A
+// right-hand tracker's (re)start search must still fit the model's fingers on the fingers, as
+// the depth says, not bunch them over the palm where the labels agree with them: the fit the
+// search keeps explains at least 0.9 of the hand. Before the labels chose only among fits that
+// explain the depth about as well as the best (start_search.cpp, kLabelChoiceLead), it chose one
+// with its fingers bunched over the palm: confidence 0.61, label agreement 0.68, against 0.97 and
+// 0.35 for the fit on the fingers, which was not refined at all (fourth by score after screening).
+TEST(RealHandStart, AHandTheForestMislabelsIsFittedAsTheDepthShowsIt) {
+  const fs::path file = kSr305Root / "20210326-230536" / "130.png";
+  if (!fs::exists(file)) GTEST_SKIP() << "shared data absent: " << file;
+  TrackerConfig config = sr305_config(EnergyMode::kLateFusion);
+  config.handedness = HandednessMode::kRight;
+  Tracker tracker(config);
+  const TrackerOutput out = tracker.track(read_sr305_frame(file), &testing::shipped_forest());
+  ASSERT_NE(out.state, TrackingState::kNoHand);
+  EXPECT_GE(out.confidence, 0.9) << "label agreement " << out.label_agreement;
+  EXPECT_LT(out.palm_normal.z(), 0.0) << "the palm faces the camera";
+}
+
 // Each SR305 frame shown kStillShown times in a row to a fresh tracker (`shown(frames)`: the hand
 // it reports at the end of the frames, nullopt for none): how many frames had a hand in the
 // working volume, and how many of them were the right hand at the end. The others are printed.
@@ -212,7 +234,9 @@ StillFrames still_frames(const std::vector<fs::path>& files, Shown&& shown) {
 // of the 19 frames (230536/170 and 231615/100, 200 left); with the forest of 5,000 images and
 // the partial leaves not split, 15 (230536/130, 150, 170 and 231615/180 left), with E_sim's
 // coverage cap and without it alike. (On the unchanged image, 17 of 17 with the cap and 14 of 17
-// without, but that alignment's luck: docs/TRACKER.md, "Real frames".) The bound: 3 of 4.
+// without, but that alignment's luck: docs/TRACKER.md, "Real frames".) Since the labels choose only
+// among fits that explain the depth about as well as the best (2026-11-30), all but 231615/200
+// (230536/130 was left before it). The bound: 3 of 4.
 TEST(RealStillHand, StaysTheRightHandWhileTracked) {
   const std::vector<fs::path> files = sr305_frames();
   if (files.empty()) GTEST_SKIP() << "shared data absent: " << kSr305Root;
@@ -233,8 +257,10 @@ TEST(RealStillHand, StaysTheRightHandWhileTracked) {
 // shared out first), the last of the trembling frames. Measured (2026-11-28, seed 1): 16 of 19
 // (230536/170 and 231615/100, 180 left; in 230536/170 the hand, arm and body are near one another);
 // with the forest of 5,000 images and the partial leaves not split, 15 (230536/150, 170 and
-// 231615/20, 200 left; 231615/20's thumb labelled a little finger). The goal, every frame
-// right, is not met; the bound (3 of 4) guards what is.
+// 231615/20, 200 left; 231615/20's thumb labelled a little finger). Since the labels choose only
+// among fits that explain the depth about as well as the best (2026-11-30), 17 of 19 (231615/180,
+// 200 left; 230536/130 was left before it). The goal, every frame right, is not met; the
+// bound (3 of 4) guards what is.
 TEST(RealStillHand, MostStayTheRightHandAsHandtrackdTracksThem) {
   const std::vector<fs::path> files = sr305_frames();
   if (files.empty()) GTEST_SKIP() << "shared data absent: " << kSr305Root;
