@@ -78,8 +78,8 @@ INSTANTIATE_TEST_SUITE_P(
 // leaves, 2026-11-28, all but 230536/170 and 231615/100, 200; and the same frame moved by one pixel
 // turns others: docs/TRACKER.md, "Real frames"). Since the labels choose only among fits that
 // explain the depth about as well as the best (2026-11-30): with late fusion all of them, depth-only
-// all but 231615/200. The bound: 3 of 4 depth-only, 2 of 3 with late fusion; the goal is
-// every frame.
+// all but 231615/200. The bound: 3 of 4 depth-only, 11 of 12 with late fusion (2 of 3 before); the
+// issue's goal is every frame.
 struct RealCase {
   EnergyMode mode;
   int min_right_hands_of_12;  // of every 12 frames with a hand, at least this many right hands
@@ -156,7 +156,7 @@ TEST_P(RealHands, Sr305FramesAreRightHandsAndTheirMirrorImagesTheOtherHand) {
 }
 
 INSTANTIATE_TEST_SUITE_P(DepthOnlyAndShipped, RealHands,
-                         ::testing::Values(RealCase{EnergyMode::kDepthOnly, 9}, RealCase{EnergyMode::kLateFusion, 8}),
+                         ::testing::Values(RealCase{EnergyMode::kDepthOnly, 9}, RealCase{EnergyMode::kLateFusion, 11}),
                          [](const ::testing::TestParamInfo<RealCase>& c) {
                            return std::string(c.param.mode == EnergyMode::kLateFusion ? "late_fusion" : "depth_only");
                          });
