@@ -37,9 +37,7 @@ SelfCalibration::SelfCalibration(const TrackerConfig& config)
 void SelfCalibration::search() {
   TrackerConfig from = config_;
   from.scale = from_;
-  // The length only (self_calibration.hpp).
-  found_ = from_;
-  found_.length = calibrate_hand_scale(set_.frames(), from).scale.length;
+  found_ = calibrate_hand_scale(set_.frames(), from).scale;
 }
 
 std::optional<HandScale> SelfCalibration::offer(const DepthInput& input, const TrackerOutput& tracked,

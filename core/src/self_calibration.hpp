@@ -5,13 +5,13 @@
 // and hands 15 % smaller or 20 % longer than it lose 4-9 mm at the fingertips (docs/TRACKER.md,
 // "Hands of other sizes"). So each hand that comes into view is calibrated from its own
 // confidently tracked frames (CalibrationSet: 12 frames, one every 5), by the same greedy search
-// (calibrate_hand_scale) from the scale it is tracked with, and then tracked with the length found.
-//
-// The length only: the search fits all three factors (the length is found with the others free),
-// but width and sigma stay as configured. With all three taken, hands of the benchmark's sizes seen
-// again in a session lost their side from behind (the 84 scenes after an open-hand sequence: 99.6
-// -> 97.4 % right; the true width does the same), while hands 15 % smaller and 20 % longer gained
-// 1.8 and 1.7 mm more than with the length alone (docs/TRACKER.md, "A hand calibrates itself").
+// (calibrate_hand_scale) from the scale it is tracked with, and then tracked with the scale found:
+// length, width and sigma. A handedness trial fits both hands with the length found but the
+// configured width and sigma (Tracker::use_calibrated_model): with the calibrated ones, hands of
+// the benchmark's sizes seen again in a session lost their side from behind (99.6 -> 97.4 % right;
+// the true width does the same). With the length alone (until 2026-11-30, eighth session) hands
+// 15 % smaller and 20 % longer tracked 1.5 and 1.2 mm worse (docs/TRACKER.md, "A hand calibrates
+// itself").
 //
 // Only frames that show the hand's size serve: the hand open and facing the camera (palm or back).
 // Calibrated from every tracked frame, the side view found every hand's width at the bottom of the

@@ -192,9 +192,9 @@ const std::vector<Field>& fields() {
      "hand profile file (handtrack-calibrate, Sec. 6): its scales replace tracker.scale; empty: tracker.scale",
      false},
     {"tracker.self_calibrate", BoolRef{[](DaemonConfig& c) -> bool& { return c.tracker.self_calibrate; }}, 0, 0,
-     "true: each hand in view has its length calibrated from its first frames held open toward the camera and is "
-     "then tracked with it (width and sigma stay tracker.scale's or the profile's); false: tracker.scale (or the "
-     "profile) throughout",
+     "true: each hand in view has its scale calibrated from its first frames held open toward the camera and is "
+     "then tracked with it (a handedness trial keeps tracker.scale's or the profile's width and sigma); false: "
+     "tracker.scale (or the profile) throughout",
      false},
     {"tracker.seed", Uint64Ref{[](DaemonConfig& c) -> uint64_t& { return c.tracker.seed; }}, 0, kMaxSeed,
      "random seed of the particle extrapolation", true},

@@ -159,8 +159,9 @@ struct TrackerConfig {
   // unreported, for this many frames: where it shows again near its last pose it is the same hand
   // (HandsTracker).
   int hidden_hand_frames = 20;
-  // Each hand that comes into view has its length calibrated from its frames held open toward the
-  // camera, and is then tracked with it (Tracker; src/self_calibration.hpp). false: `scale` always.
+  // Each hand that comes into view has its scale calibrated from its frames held open toward the
+  // camera, and is then tracked with it; a handedness trial keeps `scale`'s width and sigma
+  // (Tracker; src/self_calibration.hpp). false: `scale` always.
   bool self_calibrate = true;
   uint64_t seed = 1;
 };
@@ -254,7 +255,9 @@ class PoseTracker {
 
   [[nodiscard]] const HandModel& model() const { return search_.model(); }
   [[nodiscard]] const TrackerConfig& config() const { return config_; }
-  void set_scale(const HandScale& scale);
+  // Tracks with `model` (a default adult at another scale) from the next frame on: copied into
+  // this tracker's storage, without allocating where it has the same structure.
+  void set_model(const HandModel& model);
   // Another hand in the frame, in this tracker's camera frame, that the fit must not enter
   // (E_hand); null: none. It must outlive the optimise() calls that use it.
   void set_other_hand(const HandObstacle* other) {
@@ -442,6 +445,9 @@ class Tracker {
   // Offers the frame to the hand's self-calibration (TrackerConfig::self_calibrate) and takes the
   // scale it finds.
   void calibrate(const TrackerInputs& inputs, const TrackerOutput& out);
+  // Both hands' models as the frame needs them: the calibrated one, or in a handedness trial the
+  // trial's (calibrated_).
+  void use_calibrated_model();
 
   PoseTracker right_;
   PoseTracker left_;
@@ -467,6 +473,15 @@ class Tracker {
   uint32_t last_hand_id_ = 0;
   bool beside_other_ = false;  // set_other_hand(): another hand in view
   std::unique_ptr<SelfCalibration> calibration_;  // null: TrackerConfig::self_calibrate off
+  // The self-calibrated hand: tracked with the scale found, and fitted in a handedness trial with
+  // the length found but the configured width and sigma (self_calibration.hpp). Built once per
+  // calibration, so that a trial's start and end copy a model and allocate nothing.
+  struct CalibratedModels {
+    HandModel tracked;
+    HandModel trial;
+  };
+  HandScale configured_scale_;
+  std::optional<CalibratedModels> calibrated_;
 };
 
 }  // namespace handtrack
