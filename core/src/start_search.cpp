@@ -106,13 +106,6 @@ StartSearch::StartSearch(const TrackerConfig& config)
   screened_.reserve(kMaxStarts);
 }
 
-void StartSearch::set_scale(const HandScale& scale) {
-  // A new model allocates: only when the scale changes (a background search sets it each time).
-  if (scale == scale_) return;
-  scale_ = scale;
-  model_ = HandModel::default_adult(scale);
-}
-
 void StartSearch::set_model(const HandModel& model) {
   if (model.scale() == scale_) return;
   scale_ = model.scale();
@@ -321,18 +314,19 @@ void StartSearch::keep_best(const DepthInput& input) {
   const auto kept = std::min(kRefinedStarts, screened_.size());
   std::partial_sort(screened_.begin(), screened_.begin() + static_cast<std::ptrdiff_t>(kept), screened_.end(),
                     better);
-  const StartFit most_confident = *std::max_element(
+  if (&start_energy(input) == &energy_) {
+    screened_.resize(kept);
+    return;
+  }
+  // The first of the most confident: a kept one wherever one of them is as confident.
+  const auto most_confident = std::max_element(
       screened_.begin(), screened_.end(),
       [](const StartFit& a, const StartFit& b) { return a.explained.confidence < b.explained.confidence; });
-  const bool kept_it = std::any_of(screened_.begin(), screened_.begin() + static_cast<std::ptrdiff_t>(kept),
-                                   [&](const StartFit& f) {
-                                     return f.explained.confidence >= most_confident.explained.confidence;
-                                   });
+  const bool kept_it = most_confident < screened_.begin() + static_cast<std::ptrdiff_t>(kept);
+  const StartFit extra = *most_confident;
   screened_.resize(kept);
-  if (&start_energy(input) != &energy_) {
-    for (size_t k = 0; k < kept; ++k) screened_.push_back(screened_[k]);
-    if (!kept_it) screened_.push_back(most_confident);
-  }
+  for (size_t k = 0; k < kept; ++k) screened_.push_back(screened_[k]);
+  if (!kept_it) screened_.push_back(extra);
 }
 
 StartFit StartSearch::refine(const DepthInput& input, int iterations) {

@@ -319,9 +319,10 @@ int main(int argc, char** argv) {
   std::string hand_profile;
   app.add_option("--hand-profile", hand_profile, "hand profile (handtrack-calibrate): the user's hand scale (Sec. 6)");
   app.add_option("--self-calibrate", config.self_calibrate,
-                 "on (default): each hand's length is calibrated from its frames held open toward the camera and then "
-                 "tracked with (Sec. 6 made online; docs/TRACKER.md, \"A hand calibrates itself\"); off: the default "
-                 "model's scale (or --hand-profile's) throughout");
+                 "on (default): each hand's scale is calibrated from its frames held open toward the camera and then "
+                 "tracked with, a handedness trial keeping the configured width and sigma (Sec. 6 made online; "
+                 "docs/TRACKER.md, \"A hand calibrates itself\"); off: the default model's scale (or --hand-profile's) "
+                 "throughout");
   std::string warm_up;
   app.add_option("--warm-up", warm_up,
                  "a sequence each tracker sees first, unscored, then a frame without a hand: every scored sequence a "

@@ -76,7 +76,6 @@ class StartSearch {
   static constexpr int kScreenIterations = 15;
 
   explicit StartSearch(const TrackerConfig& config);
-  void set_scale(const HandScale& scale);
   // The model of another search of the same structure (a default adult at another scale): copied
   // into this one's storage, without allocating, where its scale differs.
   void set_model(const HandModel& model);
