@@ -74,6 +74,7 @@ struct DepthInputBuilder::Steps {
   std::vector<int32_t> region;      // drop_background_regions' scratch
   std::vector<int32_t> stack;
   HandSegmenter segmenter;
+  DepthInput unhinted;  // a hinted frame segmented without its hint, for a hand-aligned labeller
   QuadtreeBuilder quadtree;
   SelfSimilarity self_similarity{kReservedLeaves};
 };
@@ -120,7 +121,15 @@ const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::o
   // there, so no part of the hand is in front of it).
   const bool desk = steps_->support_plane.find(config_.support_plane, out_.camera, out_.filtered_mm);
   if (desk) steps_->support_plane.erase(out_.camera, out_.filtered_mm);
+  if (hint && labeller != nullptr && labeller->turns_with_hand()) {
+    DepthInput& unhinted = steps_->unhinted;
+    unhinted.camera = out_.camera;
+    unhinted.filtered_mm = out_.filtered_mm;  // same size every frame: no allocation after the first
+    steps_->segmenter.segment(config_, median, std::nullopt, unhinted, foreign);
+    out_.unhinted_axis = unhinted.finger_axis;
+  }
   steps_->segmenter.segment(config_, median, hint, out_, foreign);
+  if (!hint || labeller == nullptr || !labeller->turns_with_hand()) out_.unhinted_axis = out_.finger_axis;
   const std::vector<float>* seen = &median;
   if (desk && config_.free_space.enabled) {
     steps_->without_desk = median;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
@@ -15,7 +16,8 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "the model file is read by memcpy: little-endian only");
 
 constexpr std::array<char, 8> kMagic = {'H', 'T', 'F', 'O', 'R', 'E', 'S', 'T'};
-constexpr size_t kFixedHeaderBytes = 36;  // magic .. metadata length
+constexpr size_t kFixedHeaderBytes = 36;  // magic .. metadata length, format version 1
+constexpr uint32_t kHandAlignedProbes = 1;  // format version 2's probe frame
 constexpr size_t kChecksumBytes = 8;
 constexpr size_t kNodeBytes = 16;
 constexpr size_t kLeafBytes = 2 * kPartForestClasses;
@@ -225,16 +227,18 @@ int PartForest::max_depth() const {
 }
 
 std::vector<uint8_t> PartForest::to_bytes() const {
-  size_t size = kFixedHeaderBytes + info_.metadata.size() + 8 * trees_.size() + kChecksumBytes;
+  size_t size = kFixedHeaderBytes + (info_.hand_aligned ? 4 : 0) + info_.metadata.size() + 8 * trees_.size() +
+                kChecksumBytes;
   for (const auto& t : trees_) size += t.nodes.size() * kNodeBytes + t.leaves.size() * kLeafBytes;
   Writer w(size);
   w.put_bytes(kMagic.data(), kMagic.size());
-  w.put(kFormatVersion);
+  w.put(info_.hand_aligned ? kFormatVersion : uint32_t{1});
   w.put(static_cast<uint32_t>(kPartForestClasses));
   w.put(static_cast<uint32_t>(trees_.size()));
   w.put(info_.reference_fx);
   w.put(info_.reference_fy);
   w.put(info_.background_mm);
+  if (info_.hand_aligned) w.put(kHandAlignedProbes);
   w.put(static_cast<uint32_t>(info_.metadata.size()));
   w.put_bytes(info_.metadata.data(), info_.metadata.size());
   for (const auto& t : trees_) {
@@ -284,8 +288,8 @@ PartForest PartForest::from_bytes(std::span<const uint8_t> bytes, const std::str
     r.read_bytes(magic.data(), magic.size(), "magic");
     if (magic != kMagic) throw fail("bad magic (not a handtrack part forest file)");
     const auto version = r.read<uint32_t>("format version");
-    if (version != kFormatVersion) {
-      throw fail("unsupported format version " + std::to_string(version) + " (this build reads " +
+    if (version != 1 && version != kFormatVersion) {
+      throw fail("unsupported format version " + std::to_string(version) + " (this build reads 1 and " +
                  std::to_string(kFormatVersion) + ")");
     }
     const auto classes = r.read<uint32_t>("class count");
@@ -300,11 +304,15 @@ PartForest PartForest::from_bytes(std::span<const uint8_t> bytes, const std::str
     info.reference_fx = r.read<float>("reference fx");
     info.reference_fy = r.read<float>("reference fy");
     info.background_mm = r.read<float>("background depth");
+    if (version == kFormatVersion) {
+      const auto frame = r.read<uint32_t>("probe frame");
+      if (frame != kHandAlignedProbes) throw fail("bad probe frame " + std::to_string(frame) + " (expected 1)");
+      info.hand_aligned = true;
+    }
     const auto metadata_bytes = r.read<uint32_t>("metadata length");
     if (metadata_bytes > kMaxMetadataBytes) throw fail("bad metadata length " + std::to_string(metadata_bytes));
     info.metadata.resize(metadata_bytes);
     r.read_bytes(info.metadata.data(), metadata_bytes, "metadata");
-    static_assert(kFixedHeaderBytes == 36);
 
     std::vector<PartForestTree> trees(tree_count);
     // Node and leaf counts per tree; storage is allocated only after the file size matched them.
@@ -367,13 +375,11 @@ void PartForest::classify_batch(const Crop& crop, const Site* sites, int count, 
   };
   const double sx = crop.focal_ratio_x;
   const double sy = crop.focal_ratio_y;
-  std::array<int32_t, kBatch> kx{};
-  std::array<int32_t, kBatch> ky{};
+  std::array<ProbeSteps, kBatch> steps{};
   for (int p = 0; p < count; ++p) {
     const float d = depth[static_cast<size_t>(sites[p].y - crop.y0) * static_cast<size_t>(crop.width) +
                           static_cast<size_t>(sites[p].x - crop.x0)];
-    kx[static_cast<size_t>(p)] = probe_scale(sx, d);
-    ky[static_cast<size_t>(p)] = probe_scale(sy, d);
+    steps[static_cast<size_t>(p)] = probe_steps(sx, sy, d, crop.turn);
   }
   std::array<std::array<uint32_t, kPartForestClasses>, kBatch> sum{};
   for (const PartForestTree& tree : trees_) {
@@ -391,8 +397,9 @@ void PartForest::classify_batch(const Crop& crop, const Site* sites, int count, 
         // Crop coordinates: x + round(offset k) shifts with the crop.
         const int x = sites[p].x - crop.x0;
         const int y = sites[p].y - crop.y0;
-        const float a = probe(probe_coordinate(x, n.u[0], kx[q]), probe_coordinate(y, n.u[1], ky[q]));
-        const float b = probe(probe_coordinate(x, n.v[0], kx[q]), probe_coordinate(y, n.v[1], ky[q]));
+        const ProbeSteps& k = steps[q];
+        const float a = probe(probe_coordinate(x, n.u[0], n.u[1], k.xx, k.xy), probe_coordinate(y, n.u[0], n.u[1], k.yx, k.yy));
+        const float b = probe(probe_coordinate(x, n.v[0], n.v[1], k.xx, k.xy), probe_coordinate(y, n.v[0], n.v[1], k.yx, k.yy));
         at[q] = n.child + ((a - b) < n.threshold ? 0U : 1U);
         // The next node of this pixel is needed only after the other pixels' steps: fetch it now
         // (deep nodes are cache misses, the descent's main cost).
@@ -450,6 +457,7 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
   crop.height = y1 - y0 + 1;
   crop.focal_ratio_x = input.camera.fx / info_.reference_fx;
   crop.focal_ratio_y = input.camera.fy / info_.reference_fy;
+  if (info_.hand_aligned) crop.turn = hand_turn(input.unhinted_axis);
   crop_storage.resize(static_cast<size_t>(crop.width) * static_cast<size_t>(crop.height));
   for (int y = y0; y <= y1; ++y) {
     float* row = crop_storage.data() + static_cast<size_t>(y - y0) * static_cast<size_t>(crop.width);
@@ -515,6 +523,13 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
     }
   }
   if (pending > 0) flush();
+}
+
+InPlaneTurn hand_turn(const Eigen::Vector3d& finger_axis) {
+  // R (0, -1) = (sin, -cos) must be the axis' image direction (x, y) / |(x, y)|.
+  const double norm = std::hypot(finger_axis.x(), finger_axis.y());
+  if (!(norm > 1e-9)) return {};
+  return {-finger_axis.y() / norm, finger_axis.x() / norm};
 }
 
 std::optional<std::filesystem::path> shipped_forest_path() {

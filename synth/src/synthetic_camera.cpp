@@ -224,8 +224,19 @@ struct SyntheticCamera::State {
   // z-buffer does not care about the order).
   Raycaster background;
 
+  // The camera's turn about its optical axis (SynthOptions::roll_deg): camera-frame points turn by it.
+  Eigen::Matrix3d roll;
+
   State(SynthOptions o, const std::array<HandShape, kTwoHands>& s)
-      : options(std::move(o)), shapes(s), raycaster(render_camera(options)), background(render_camera(options)) {
+      : options(std::move(o)),
+        shapes(s),
+        raycaster(render_camera(options)),
+        background(render_camera(options)),
+        roll(Eigen::AngleAxisd(options.roll_deg * M_PI / 180.0, Vector3d::UnitZ()).toRotationMatrix()) {
+    // A forearm drawn along a camera-frame direction (views.hpp view_shape) turns with the camera.
+    for (HandShape& shape : shapes) {
+      if (shape.forearm_camera_direction) shape.forearm_camera_direction = roll * *shape.forearm_camera_direction;
+    }
     if (is_two_hand_motion(options.motion)) {
       two_hands.emplace(options.motion, options.frames, options.camera.fps, shapes);
     } else {
@@ -251,6 +262,7 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
                               : options.depth_offset_mm != 0.0        ? "a depth offset"
                               : options.arm == Arm::kShoulder         ? "the upper arm"
                               : options.arm == Arm::kNone             ? "a hand without its arm"
+                              : options.roll_deg != 0.0               ? "a rolled camera"
                                                                       : nullptr;
   if (is_two_hand_motion(options.motion) && one_hand_only != nullptr) {
     throw std::invalid_argument("motion '" + options.motion + "': " + one_hand_only + " is for one-hand motions");
@@ -260,6 +272,11 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   }
   if (!(std::abs(options.depth_offset_mm) <= kMaxDepthOffsetMm)) {
     throw std::invalid_argument("depth offset must be within [-250, 250] mm");
+  }
+  if (!(std::abs(options.roll_deg) <= 180.0)) throw std::invalid_argument("roll must be within [-180, 180] deg");
+  if (options.roll_deg != 0.0 && (options.background == Background::kDesk || options.arm == Arm::kShoulder)) {
+    throw std::invalid_argument("a rolled camera is not drawn with the desk or the upper arm (both are placed in the "
+                                "camera's frame)");
   }
   std::array<SubjectScale, kTwoHands> subjects;
   if (options.subject) {
@@ -347,6 +364,19 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
       planes.push_back(make_patch({0, 250, 750}, kTableUp, 0.0, 0.0));
       break;
   }
+  if (s.options.roll_deg != 0.0) {
+    const Eigen::Matrix3d& r = s.roll;
+    for (auto& p : planes) {
+      p.origin = r * p.origin;
+      p.normal = r * p.normal;
+      p.axis_u = r * p.axis_u;
+      p.axis_v = r * p.axis_v;
+    }
+    for (auto& c : background_solids) {
+      c.a = r * c.a;
+      c.b = r * c.b;
+    }
+  }
   s.background.clear();
   for (const auto& p : background_solids) s.background.draw(p);
   for (const auto& p : planes) s.background.draw(p);
@@ -374,6 +404,12 @@ HandPose SyntheticCamera::pose(int frame, int hand) const {
     // Along the palm centre's ray: the hand keeps its place in the image and grows or shrinks.
     const Vector3d palm = p.translation_mm + camera_R_hand(p.rotation) * s.shapes[0].palm_centre_mm;
     p.translation_mm += palm * (s.options.depth_offset_mm / palm.z());
+  }
+  if (s.options.roll_deg != 0.0) {
+    // camera_R_hand = exp(r) R0 turns into roll exp(r) R0; the wrist turns about the lens.
+    const Eigen::AngleAxisd exp_r(s.roll * camera_R_hand(p.rotation) * camera_R_hand(Vector3d::Zero()).transpose());
+    p.rotation = exp_r.angle() * exp_r.axis();
+    p.translation_mm = s.roll * p.translation_mm;
   }
   return p;
 }

@@ -479,6 +479,54 @@ TEST(SynthCamera, RendersA320x240FrameInAFewMilliseconds) {
 #endif
 }
 
+// A camera rolled about its optical axis (--roll): the ground truth turns with it, and the forearm,
+// which comes up from the image bottom in the desk views, enters from the side the roll takes the
+// bottom to (a quarter turn: the left); the hand stays the same size in the image.
+TEST(SynthCamera, ARolledCameraTurnsTheHandAndItsForearmToAnotherEdge) {
+  const auto render = [](double roll_deg) {
+    SynthOptions o = clean_options("adbadd", Background::kNone);
+    o.roll_deg = roll_deg;
+    return SyntheticCamera(o).render(60);
+  };
+  const SynthFrame upright = render(0.0);
+  const SynthFrame rolled = render(90.0);
+  const Eigen::Matrix3d quarter = Eigen::AngleAxisd(M_PI / 2.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (size_t j = 0; j < upright.joints.size(); ++j) {
+    EXPECT_LT((rolled.joints[j] - quarter * upright.joints[j]).norm(), 1e-6) << "joint " << j;
+  }
+  // Where the forearm (depth without a hand label) lies from the hand in the image, in px: the
+  // centroids' offset, and the hand's pixel count.
+  struct Layout {
+    Eigen::Vector2d forearm_from_hand;
+    int hand = 0;
+  };
+  const auto layout = [](const SynthFrame& f) {
+    const int w = f.depth.width();
+    Eigen::Vector2d hand_sum = Eigen::Vector2d::Zero();
+    Eigen::Vector2d arm_sum = Eigen::Vector2d::Zero();
+    int hand = 0, arm = 0;
+    for (size_t k = 0; k < f.labels.pixels.size(); ++k) {
+      if (f.depth.depth_mm[k] <= 0.0F) continue;
+      const Eigen::Vector2d uv(static_cast<double>(k % static_cast<size_t>(w)), static_cast<double>(k / static_cast<size_t>(w)));
+      if (f.labels.pixels[k] != 0) {
+        hand_sum += uv;
+        ++hand;
+      } else {
+        arm_sum += uv;
+        ++arm;
+      }
+    }
+    return Layout{arm_sum / std::max(arm, 1) - hand_sum / std::max(hand, 1), hand};
+  };
+  const Layout up = layout(upright);
+  const Layout turned = layout(rolled);
+  EXPECT_GT(up.forearm_from_hand.y(), 40.0) << "below the hand";
+  EXPECT_LT(std::abs(up.forearm_from_hand.x()), 20.0);
+  EXPECT_LT(turned.forearm_from_hand.x(), -40.0) << "left of the hand";
+  EXPECT_LT(std::abs(turned.forearm_from_hand.y()), 20.0);
+  EXPECT_NEAR(turned.hand, up.hand, 0.05 * up.hand);
+}
+
 TEST(SynthCamera, RejectsBadOptions) {
   SynthOptions o;
   o.motion = "moonwalk";
@@ -497,6 +545,19 @@ TEST(SynthCamera, RejectsBadOptions) {
   EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
   o.subject = SubjectScale{};
   o.subject->palm_thickness = std::nan("");
+  EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
+  o = SynthOptions{};
+  o.roll_deg = 181.0;
+  EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
+  o.roll_deg = 90.0;
+  EXPECT_NO_THROW(SyntheticCamera{o});
+  o.background = Background::kDesk;  // placed in the camera's frame: not rolled
+  EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
+  o.background = Background::kBody;
+  o.arm = Arm::kShoulder;
+  EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
+  o.arm = Arm::kForearm;
+  o.motion = "two_apart";
   EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
 }
 

@@ -70,7 +70,8 @@ PartForestLeaf one_hot(int c) {
 
 // One stump: f = d(x + u / d(x)) - d(x) with u = (offset_pxmm, 0): a pixel whose probe to the right
 // leaves the hand reads the background (a large f) and goes right (class 2), others left (class 1).
-PartForest right_edge_stump(int16_t offset_pxmm, float reference_fx) {
+// Hand-aligned (PartForestInfo::hand_aligned): "to the right" is the hand's right, fingers up.
+PartForest right_edge_stump(int16_t offset_pxmm, float reference_fx, bool hand_aligned = false) {
   PartForestTree t;
   t.nodes.resize(3);
   t.nodes[0].u = {offset_pxmm, 0};
@@ -82,6 +83,7 @@ PartForest right_edge_stump(int16_t offset_pxmm, float reference_fx) {
   t.leaves = {one_hot(1), one_hot(2)};
   PartForestInfo info;
   info.reference_fx = info.reference_fy = reference_fx;
+  info.hand_aligned = hand_aligned;
   info.metadata = "test stump";
   return PartForest({t}, info, PartForestOptions{1});
 }
@@ -136,12 +138,59 @@ TEST(PartForestFeatures, StrideLabelsEveryHandPixelAndNothingElse) {
 TEST(PartForestFeatures, ProbeArithmeticRoundsHalvesUpAndClampsHugeScales) {
   const int32_t k = probe_scale(1.0, 256.0F);  // 1/256 px per px mm, exact in 16.16
   EXPECT_EQ(k, 256);
-  EXPECT_EQ(probe_coordinate(10, 2560, k), 20);
-  EXPECT_EQ(probe_coordinate(10, -2560, k), 0);
-  EXPECT_EQ(probe_coordinate(0, 128, k), 1);   // 0.5 -> 1
-  EXPECT_EQ(probe_coordinate(0, -128, k), 0);  // -0.5 -> 0
-  EXPECT_EQ(probe_coordinate(0, 4000, probe_scale(1.0, 400.0F)), 10);
-  EXPECT_GT(probe_coordinate(0, 32767, probe_scale(1.0, 0.0F)), 1000000);  // no overflow, far outside
+  EXPECT_EQ(probe_coordinate(10, 2560, 0, k, 0), 20);
+  EXPECT_EQ(probe_coordinate(10, -2560, 0, k, 0), 0);
+  EXPECT_EQ(probe_coordinate(0, 128, 0, k, 0), 1);   // 0.5 -> 1
+  EXPECT_EQ(probe_coordinate(0, -128, 0, k, 0), 0);  // -0.5 -> 0
+  EXPECT_EQ(probe_coordinate(0, 4000, 0, probe_scale(1.0, 400.0F), 0), 10);
+  EXPECT_GT(probe_coordinate(0, 32767, 32767, probe_scale(1.0, 0.0F), probe_scale(1.0, 0.0F)), 1000000);  // no overflow
+  // Without a turn the steps are the two scales; a hand whose fingers point to the image's right
+  // (a quarter turn) reads the offset "up the hand" (0, -2560) 10 px to the right, on its row.
+  const ProbeSteps plain = probe_steps(1.0, 2.0, 256.0F, InPlaneTurn{});
+  EXPECT_EQ(plain.xx, 256);
+  EXPECT_EQ(plain.yy, 512);
+  EXPECT_EQ(plain.xy, 0);
+  EXPECT_EQ(plain.yx, 0);
+  const ProbeSteps turned = probe_steps(1.0, 1.0, 256.0F, hand_turn(Eigen::Vector3d(1.0, 0.0, 0.0)));
+  EXPECT_EQ(probe_coordinate(10, 0, -2560, turned.xx, turned.xy), 20);
+  EXPECT_EQ(probe_coordinate(10, 0, -2560, turned.yx, turned.yy), 10);
+  // Fingers up the image turn nothing; fingers along the viewing ray neither.
+  for (const Eigen::Vector3d& axis : {Eigen::Vector3d(0.0, -1.0, 0.0), Eigen::Vector3d(0.0, 0.0, 1.0)}) {
+    const InPlaneTurn t = hand_turn(axis);
+    EXPECT_EQ(t.cos, 1.0);
+    EXPECT_EQ(t.sin, 0.0);
+  }
+}
+
+// A hand-aligned forest reads its offsets in the hand's frame (the segmentation's unhinted axis): the
+// stump's "to the right" is the image's right for fingers up the image, the image's top for
+// fingers pointing to the image's left, and the image's bottom for fingers pointing right. A forest
+// in the image's axes ignores the axis.
+TEST(PartForestFeatures, AHandAlignedForestProbesInTheHandsFrame) {
+  const PartForest aligned = right_edge_stump(4000, 200.0F, true);
+  const PartForest plain = right_edge_stump(4000, 200.0F, false);
+  DepthInput in = square_input(320, 240, 400.0F, 40, 200.0);
+  // The square spans x, y in [120, 200) x [80, 160): 10 px from an edge is the probe's reach.
+  const auto label_at = [&](const PartForest& f, int x, int y) {
+    std::vector<uint8_t> labels;
+    f.label(in, labels);
+    return labels[static_cast<size_t>(y) * 320 + x];
+  };
+  const int right = 195;   // within 10 px of the right edge, mid-height
+  const int top = 85;      // within 10 px of the top edge, mid-width
+  const int bottom = 155;  // within 10 px of the bottom edge
+  in.unhinted_axis = Eigen::Vector3d(0.0, -1.0, 0.0);
+  EXPECT_EQ(label_at(aligned, right, 120), 2);
+  EXPECT_EQ(label_at(aligned, 160, top), 1);
+  in.unhinted_axis = Eigen::Vector3d(-1.0, 0.0, 0.2).normalized();
+  EXPECT_EQ(label_at(aligned, right, 120), 1);
+  EXPECT_EQ(label_at(aligned, 160, top), 2);
+  EXPECT_EQ(label_at(aligned, 160, bottom), 1);
+  EXPECT_EQ(label_at(plain, right, 120), 2);
+  EXPECT_EQ(label_at(plain, 160, top), 1);
+  in.unhinted_axis = Eigen::Vector3d(1.0, 0.0, 0.0);
+  EXPECT_EQ(label_at(aligned, 160, bottom), 2);
+  EXPECT_EQ(label_at(aligned, 160, top), 1);
 }
 
 // A small trained model for the file tests (trained once per process).
@@ -258,8 +307,8 @@ TEST(PartForestFile, CorruptFilesGiveOneLineNamingTheProblem) {
   bytes[0] = 'X';
   expect_error(bytes, "bad magic");
   bytes = good;
-  bytes[8] = 2;  // version 2
-  expect_error(bytes, "unsupported format version 2");
+  bytes[8] = 3;  // version 3
+  expect_error(bytes, "unsupported format version 3");
   for (size_t keep : {size_t{0}, size_t{5}, size_t{20}, size_t{40}, good.size() / 2, good.size() - 1}) {
     expect_error(std::vector<uint8_t>(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(keep)), "truncated");
   }
@@ -310,6 +359,30 @@ TEST(PartForestFile, CorruptFilesGiveOneLineNamingTheProblem) {
   expect_error(bytes, "class count");
 
   EXPECT_THROW((void)PartForest::load(fs::path(HANDTRACK_BINARY_DIR) / "no_such_model.htf"), std::runtime_error);
+}
+
+// A hand-aligned forest is written as format version 2, whose probe frame field says so; a forest
+// in the image's axes is written as version 1, byte for byte as before the field existed.
+TEST(PartForestFile, AHandAlignedForestIsVersionTwoAndSaysSo) {
+  const auto version_of = [](const std::vector<uint8_t>& bytes) {
+    uint32_t v = 0;
+    std::memcpy(&v, bytes.data() + 8, sizeof v);
+    return v;
+  };
+  const std::vector<uint8_t> aligned = right_edge_stump(4000, 200.0F, true).to_bytes();
+  const std::vector<uint8_t> plain = right_edge_stump(4000, 200.0F, false).to_bytes();
+  EXPECT_EQ(version_of(aligned), 2U);
+  EXPECT_EQ(version_of(plain), 1U);
+  EXPECT_EQ(aligned.size(), plain.size() + 4);
+  const PartForest back = PartForest::from_bytes(aligned, "model.htf");
+  EXPECT_TRUE(back.info().hand_aligned);
+  EXPECT_EQ(back.info().metadata, "test stump");
+  EXPECT_EQ(back.to_bytes(), aligned);
+  EXPECT_FALSE(PartForest::from_bytes(plain, "model.htf").info().hand_aligned);
+  auto forged = aligned;
+  forged[32] = 2;
+  fix_checksum(forged);
+  expect_error(forged, "bad probe frame 2");
 }
 
 TEST(PartForestFile, ThousandsOfRandomMutationsNeverCrash) {

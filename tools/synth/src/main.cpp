@@ -99,6 +99,7 @@ void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticC
                       {"ball_radius_mm", o.ball_radius_mm},
                       {"proportions", std::string(handtrack::synth::proportions_name(o.proportions))},
                       {"arm", std::string(handtrack::synth::arm_name(o.arm))},
+                      {"roll_deg", o.roll_deg},
                       {"pose_parameters", "poses.csv: frame, t_x,t_y,t_z (mm, wrist), r_x,r_y,r_z (axis-angle, "
                                           "R = exp(r) diag(1,-1,-1)), thumb..little abd,flex1,flex2,flex3 (rad)"}};
   if (cam.hand_count() == 1) {
@@ -230,6 +231,11 @@ int main(int argc, char** argv) {
                  "Move the hand this many mm along the ray through its palm centre in every frame: negative nearer "
                  "the camera, positive farther (default 0: where the view puts it; one-hand motions)")
       ->check(CLI::Range(-250.0, 250.0));
+  app.add_option("--roll", options.roll_deg,
+                 "Turn the camera about its optical axis by this many degrees: the hand, forearm and scene turn "
+                 "together in the image, so the forearm enters from another edge (default 0; 90: from the image's "
+                 "left in the desk views; one-hand motions, not with --background desk or --arm shoulder)")
+      ->check(CLI::Range(-180.0, 180.0));
   std::string arm = "forearm";
   app.add_option("--arm", arm,
                  "How much of the arm to render: forearm (default: it ends at the elbow), none (the hand alone, cut "

@@ -157,6 +157,7 @@ LabelledImage crop_hand(const DepthInput& input, const std::vector<uint8_t>& tru
   img.height = y1 - y0 + 1;
   img.depth_mm.assign(static_cast<size_t>(img.width) * img.height, kBackgroundDepthMm);
   img.labels.assign(img.depth_mm.size(), LabelledImage::kOffMask);
+  img.turn = hand_turn(input.unhinted_axis);  // built without a hint: finger_axis
   for (int y = y0; y <= y1; ++y) {
     for (int x = x0; x <= x1; ++x) {
       const size_t i = static_cast<size_t>(y) * w + x;

@@ -253,6 +253,12 @@ int main(int argc, char** argv) {
                  "Far end of the working volume the training frames are segmented in")
       ->check(CLI::Range(300.0, 1500.0))
       ->capture_default_str();
+  std::string probes = "image";
+  app.add_option("--probes", probes,
+                 "image (the paper's: offsets in the image's axes) or hand (offsets turned with the hand's in-plane "
+                 "axis, the segmentation's finger axis: a forearm from any image edge is probed alike)")
+      ->check(CLI::IsMember({"image", "hand"}))
+      ->capture_default_str();
   app.add_option("--seed", train.seed, "Seed of the data set and of the training");
   app.add_option("--threads", train.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 256));
   app.add_option("--evaluate", evaluate_model, "Evaluate MODEL on held-out synthetic frames and print the "
@@ -273,6 +279,7 @@ int main(int argc, char** argv) {
   app.add_option("--far-mm", far_mm, "--apply far end of the working volume (mm)")->check(CLI::PositiveNumber);
 
   if (const auto exit_code = handtrack::parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
+  train.hand_aligned = probes == "hand";
 
   try {
     if (!apply_model.empty()) {
@@ -311,7 +318,7 @@ int main(int argc, char** argv) {
             << " --varied-fraction " << scene.varied_fraction << " --distance-spread-mm " << scene.distance_spread_mm
             << " --armless-fraction " << scene.armless_fraction
             << " --pose-far-mm " << scene.far_mm
-            << " --volume-far-mm " << scene.volume_far_mm << " --seed " << train.seed;
+            << " --volume-far-mm " << scene.volume_far_mm << " --probes " << probes << " --seed " << train.seed;
     const auto t1 = std::chrono::steady_clock::now();
     progress.restart();
     PartForest model = forest::train_forest(data, scene.camera, train, command.str(), [&](const forest::TrainProgress& p) {
@@ -333,8 +340,9 @@ int main(int argc, char** argv) {
                   100.0 * eval.motions.overall.accuracy(), 100.0 * eval.facing.accuracy(),
                   100.0 * eval.turned.accuracy());
     meta << command.str() << buf;
-    model = PartForest(model.trees(), PartForestInfo{model.info().reference_fx, model.info().reference_fy,
-                                                     model.info().background_mm, meta.str()});
+    PartForestInfo info = model.info();
+    info.metadata = meta.str();
+    model = PartForest(model.trees(), std::move(info));
     model.save(out);
     std::cout << meta.str() << "\n";
     std::snprintf(buf, sizeof buf, "render %.0f s, train %.0f s on %d threads", render_s, train_s, train.threads);

@@ -24,14 +24,14 @@ uint64_t mix(uint64_t x) {  // splitmix64 finaliser: node keys of the children
   return x ^ (x >> 31);
 }
 
-// One training pixel: the image, its position in the crop, the probe scales (f / f_ref) / d(x),
-// computed as PartForest::label() does (probe_scale), and its class.
+// One training pixel: the image, its position in the crop, the probe steps ((f / f_ref) / d(x),
+// turned with the hand for a hand-aligned forest), computed as PartForest::label() does
+// (probe_steps), and its class.
 struct Sample {
   uint32_t image = 0;
   uint16_t x = 0;
   uint16_t y = 0;
-  int32_t kx = 0;
-  int32_t ky = 0;
+  ProbeSteps steps;
   uint8_t label = 0;
 };
 
@@ -86,9 +86,7 @@ class TreeBuilder {
         s.image = static_cast<uint32_t>(i);
         s.x = static_cast<uint16_t>(hand[k] % static_cast<uint32_t>(im.width));
         s.y = static_cast<uint16_t>(hand[k] / static_cast<uint32_t>(im.width));
-        const float d = im.depth_mm[hand[k]];
-        s.kx = probe_scale(sx, d);
-        s.ky = probe_scale(sy, d);
+        s.steps = probe_steps(sx, sy, im.depth_mm[hand[k]], o_.hand_aligned ? im.turn : InPlaneTurn{});
         s.label = im.labels[hand[k]];
         samples_.push_back(s);
       }
@@ -119,8 +117,9 @@ class TreeBuilder {
       }
       return im.depth_mm[static_cast<size_t>(py) * static_cast<size_t>(im.width) + static_cast<size_t>(px)];
     };
-    return probe(probe_coordinate(s.x, f.u[0], s.kx), probe_coordinate(s.y, f.u[1], s.ky)) -
-           probe(probe_coordinate(s.x, f.v[0], s.kx), probe_coordinate(s.y, f.v[1], s.ky));
+    const ProbeSteps& k = s.steps;
+    return probe(probe_coordinate(s.x, f.u[0], f.u[1], k.xx, k.xy), probe_coordinate(s.y, f.u[0], f.u[1], k.yx, k.yy)) -
+           probe(probe_coordinate(s.x, f.v[0], f.v[1], k.xx, k.xy), probe_coordinate(s.y, f.v[0], f.v[1], k.yx, k.yy));
   }
 
   Feature random_feature(synth::Rng& rng) const {
@@ -371,6 +370,7 @@ PartForest train_forest(const std::vector<LabelledImage>& images, const CameraIn
   info.reference_fx = static_cast<float>(reference.fx);
   info.reference_fy = static_cast<float>(reference.fy);
   info.background_mm = kBackgroundDepthMm;
+  info.hand_aligned = options.hand_aligned;
   info.metadata = metadata;
   std::vector<PartForestTree> trees;
   std::mutex progress_mutex;

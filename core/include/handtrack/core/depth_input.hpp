@@ -85,6 +85,11 @@ struct DepthInput {
   Eigen::Vector3d hand_centroid_mm = Eigen::Vector3d::Zero();  // mean 3D point of the hand pixels
   Eigen::Vector3d palm_centre_mm = Eigen::Vector3d::Zero();    // estimated palm centre
   Eigen::Vector3d finger_axis = Eigen::Vector3d(0, -1, 0);     // estimated wrist->fingers direction
+  // The wrist->fingers direction the segmentation finds without a hint (the hand-and-forearm blob's
+  // axis, toward the end that stays in the image): finger_axis of a frame segmented without one.
+  // With a hint it is found only for a labeller that asks (PixelLabeller::turns_with_hand), else
+  // it is finger_axis.
+  Eigen::Vector3d unhinted_axis = Eigen::Vector3d(0, -1, 0);
   [[nodiscard]] bool has_hand() const { return !gaussians.empty(); }
 };
 
@@ -114,6 +119,9 @@ class PixelLabeller {
   // Fills `labels` (resized to the image) for the pixels where input.hand_mask is set; others 0.
   // Reads input.filtered_mm, input.hand_mask and input.camera.
   virtual void label(const DepthInput& input, std::vector<uint8_t>& labels) const = 0;
+  // True when label() reads input.unhinted_axis (a hand-aligned forest, part_forest.hpp): a frame
+  // segmented with a hint is then segmented once more without it, for the axis it was trained on.
+  [[nodiscard]] virtual bool turns_with_hand() const { return false; }
 };
 
 // A PixelLabeller that copies a given label image (ground truth) of the camera's own frame, for

@@ -10,19 +10,27 @@
 // they cover the same metric distance at any depth and, scaled by fx / fx_ref and fy / fy_ref at
 // run time, at any resolution. A probe outside the image or off the hand mask reads the model's
 // constant background depth (a "large positive constant" in Shotton et al.).
+// A hand-aligned forest (PartForestInfo::hand_aligned; ours) reads u and v in the hand's own image
+// frame: turned by the in-plane angle of the wrist->fingers axis the segmentation finds without a
+// hint (DepthInput::unhinted_axis), so that a hand whose forearm enters from any image edge is
+// probed as one whose fingers point up the image. Its training images are turned alike
+// (train_forest), and the trees need not learn every roll of every part. The tracked pose's axis
+// (the hint's) is not the one trained on: with it, tracking lost 0.7 mm (docs/FOREST.md).
 // A pixel goes left when f < threshold. Its class distribution is the mean of the trees' leaf
 // distributions (Criminisi and Shotton 2013); the label is the argmax.
 //
-// Model file (little-endian; written by save(), read by load()), format version 1:
+// Model file (little-endian; written by save(), read by load()), format version 1 (probes in the
+// image's axes) or 2 (hand-aligned; the one field more, and every field after it 4 bytes later):
 //
 //   offset  size  field
 //        0     8  magic "HTFOREST"
-//        8     4  u32 format version (kFormatVersion)
+//        8     4  u32 format version (1 or kFormatVersion = 2)
 //       12     4  u32 classes (must be kPartForestClasses = 13: background + 12 parts)
 //       16     4  u32 trees T (1..kMaxTrees)
 //       20     4  f32 reference fx (pixels)
 //       24     4  f32 reference fy (pixels)
 //       28     4  f32 background depth (mm) read by probes off the hand
+//      (32     4  u32 probe frame: 1 = hand-aligned; version 2 only, where it must be 1)
 //       32     4  u32 metadata length M (<= kMaxMetadataBytes)
 //       36     M  metadata: UTF-8 text, training command and statistics
 //     ...  8 T  per tree: u32 node count N_t, u32 leaf count L_t
@@ -78,6 +86,7 @@ struct PartForestInfo {
   float reference_fx = static_cast<float>(SpecCamera::kFx);  // focal lengths the offsets were trained at
   float reference_fy = static_cast<float>(SpecCamera::kFy);
   float background_mm = 4000.0F;  // depth read by probes outside the image or off the hand
+  bool hand_aligned = false;      // offsets in the hand's frame (hand_turn), not the image's
   std::string metadata;           // free text: how the model was trained
 };
 
@@ -101,13 +110,40 @@ inline int32_t probe_scale(double focal_ratio, float depth_mm) {
   const double k = focal_ratio / static_cast<double>(depth_mm) * 65536.0;
   return static_cast<int32_t>(std::lround(std::isfinite(k) ? std::fmin(std::fmax(k, 0.0), kMax) : kMax));
 }
-inline int probe_coordinate(int x, int16_t offset, int32_t scale) {
-  return x + static_cast<int>((int64_t{offset} * scale + (int64_t{1} << (kProbeScaleBits - 1))) >> kProbeScaleBits);
+// The turn in the image plane (y down) that takes "fingers up the image" (0, -1) to the image
+// direction of `finger_axis` (its x and y; an axis along the viewing ray turns nothing):
+// (x, y) -> (cos x - sin y, sin x + cos y).
+struct InPlaneTurn {
+  double cos = 1.0;
+  double sin = 0.0;
+};
+InPlaneTurn hand_turn(const Eigen::Vector3d& finger_axis);
+
+// A pixel's probe steps in 16.16: an offset (u_x, u_y) reads pixel
+// (x + round((xx u_x + xy u_y) / 65536), y + round((yx u_x + yy u_y) / 65536)), the turn applied
+// to the metric offset before each axis' scale (f / f_ref) / d(x). Without a turn: {kx, 0, 0, ky}.
+struct ProbeSteps {
+  int32_t xx = 0;
+  int32_t xy = 0;
+  int32_t yx = 0;
+  int32_t yy = 0;
+};
+inline ProbeSteps probe_steps(double focal_ratio_x, double focal_ratio_y, float depth_mm, const InPlaneTurn& turn) {
+  const int32_t kx = probe_scale(focal_ratio_x, depth_mm);
+  const int32_t ky = probe_scale(focal_ratio_y, depth_mm);
+  if (turn.cos == 1.0 && turn.sin == 0.0) return {kx, 0, 0, ky};
+  const auto step = [](int32_t k, double c) { return static_cast<int32_t>(std::lround(k * c)); };
+  return {step(kx, turn.cos), step(kx, -turn.sin), step(ky, turn.sin), step(ky, turn.cos)};
+}
+// One coordinate of a probe: x plus the rounded step of offset (a, b) along steps (ka, kb).
+inline int probe_coordinate(int x, int16_t a, int16_t b, int32_t ka, int32_t kb) {
+  return x + static_cast<int>((int64_t{a} * ka + int64_t{b} * kb + (int64_t{1} << (kProbeScaleBits - 1))) >>
+                              kProbeScaleBits);
 }
 
 class PartForest final : public PixelLabeller {
  public:
-  static constexpr uint32_t kFormatVersion = 1;
+  static constexpr uint32_t kFormatVersion = 2;  // hand-aligned; image-aligned forests are written as 1
   static constexpr int kMaxTrees = 64;
   static constexpr uint32_t kMaxMetadataBytes = 1U << 16;
   static constexpr uint32_t kMaxNodesPerTree = 1U << 26;
@@ -131,6 +167,7 @@ class PartForest final : public PixelLabeller {
   // PixelLabeller: labels (resized to the image) get the argmax class of every hand-mask pixel,
   // 0 elsewhere. No allocation once `labels` has the image's size.
   void label(const DepthInput& input, std::vector<uint8_t>& labels) const override;
+  [[nodiscard]] bool turns_with_hand() const override { return info_.hand_aligned; }
 
   [[nodiscard]] const std::vector<PartForestTree>& trees() const { return trees_; }
   [[nodiscard]] const PartForestInfo& info() const { return info_; }
@@ -155,6 +192,7 @@ class PartForest final : public PixelLabeller {
     int height = 0;
     double focal_ratio_x = 1.0;  // fx / fx_ref
     double focal_ratio_y = 1.0;
+    InPlaneTurn turn;  // the hand's, for a hand-aligned forest
   };
   void classify_batch(const Crop& crop, const Site* sites, int count, uint8_t* out) const;
 

@@ -105,6 +105,11 @@ struct SynthOptions {
   // How much of the arm is drawn (one-hand motions, but for the default). The forearm ends in a
   // rounded elbow, which a wide lens shows (docs/TRACKER.md, "Other cameras").
   Arm arm = Arm::kForearm;
+  // The camera turned about its optical axis by this many degrees (within [-180, 180]; one-hand
+  // motions, not with the desk or the upper arm): the hand, its forearm and the scene behind turn
+  // together in the image, so the forearm enters from another edge (90: from the image's left for
+  // the desk views).
+  double roll_deg = 0.0;
 };
 
 // The virtual camera as handtrackd's `synthetic[:MOTION]` source shows it: `frames` per pass of

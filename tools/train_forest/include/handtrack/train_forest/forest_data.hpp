@@ -31,6 +31,7 @@ struct LabelledImage {
   std::vector<float> depth_mm;  // filtered depth on the mask, kBackgroundDepthMm elsewhere
   std::vector<uint8_t> labels;  // class 0..12 on the mask, kOffMask elsewhere
   int hand_pixels = 0;
+  InPlaneTurn turn;  // hand_turn() of the segmentation's unhinted axis: a hand-aligned forest's probes
   static constexpr uint8_t kOffMask = 255;
 };
 
