@@ -588,6 +588,36 @@ TEST(PartForestTraining, ArmlessFractionDrawsThatShareWithoutTheArmAndNothingEls
   expect_half_changed_and_nothing_else(half, [](const forest::Scene& s) { return s.options.arm == synth::Arm::kNone; });
 }
 
+TEST(PartForestTraining, RolledFractionTurnsAShareOfTheMotionImagesAndNothingElse) {
+  // --rolled-fraction: a share of the motion images seen through a camera rolled by an angle drawn
+  // from [-180, 180] deg (synth --roll), from a stream of its own; the random poses, which roll
+  // already, and everything else as without it.
+  forest::SceneOptions half;
+  half.rolled_fraction = 0.5;
+  const forest::SceneOptions none;
+  int motions = 0;
+  int rolled = 0;
+  int beyond_quarter = 0;
+  for (uint64_t i = 0; i < 200; ++i) {
+    const forest::Scene s = forest::make_scene(9, i, half);
+    const forest::Scene plain = forest::make_scene(9, i, none);
+    EXPECT_EQ(plain.options.roll_deg, 0.0);
+    expect_the_same_scene_otherwise(s, plain);
+    if (!s.from_motion) {
+      EXPECT_EQ(s.options.roll_deg, 0.0);
+      continue;
+    }
+    ++motions;
+    EXPECT_LE(std::abs(s.options.roll_deg), 180.0);
+    rolled += s.options.roll_deg != 0.0 ? 1 : 0;
+    beyond_quarter += std::abs(s.options.roll_deg) > 90.0 ? 1 : 0;
+  }
+  EXPECT_GT(motions, 30);
+  EXPECT_GT(rolled, motions * 30 / 100);
+  EXPECT_LT(rolled, motions * 70 / 100);
+  EXPECT_GT(beyond_quarter, 0);
+}
+
 TEST(SynthRenderPose, RenderingAMotionsPoseEqualsRenderingItsFrame) {
   synth::SynthOptions o;
   o.motion = "tigergrasp";

@@ -17,6 +17,7 @@ constexpr uint64_t kSceneStream = 0xF0E57;  // Rng::stream purpose of the scene 
 constexpr uint64_t kProportionStream = 0x960B0;  // ... and of SceneOptions::varied_fraction's
 constexpr uint64_t kDistanceStream = 0xD157;      // ... and of SceneOptions::distance_spread_mm's
 constexpr uint64_t kArmStream = 0xA53;            // ... and of SceneOptions::armless_fraction's
+constexpr uint64_t kRollStream = 0x5011;          // ... and of SceneOptions::rolled_fraction's
 constexpr double kSubjectSpread = 0.10;      // subjects within +-10 % (as the synth's random subjects)
 constexpr int kTrainingSequenceFrames = 300;  // motion frames are drawn from 300-frame sequences
 constexpr int kHeldOutSequenceFrames = 241;   // held-out motions: other lengths, so other time samples
@@ -106,6 +107,10 @@ Scene make_scene(uint64_t seed, uint64_t index, const SceneOptions& options) {
   if (options.armless_fraction > 0.0 &&
       synth::Rng::stream(seed, index, kArmStream).uniform() < options.armless_fraction) {
     s.options.arm = synth::Arm::kNone;
+  }
+  if (s.from_motion && options.rolled_fraction > 0.0) {
+    synth::Rng rng_roll = synth::Rng::stream(seed, index, kRollStream);
+    if (rng_roll.uniform() < options.rolled_fraction) s.options.roll_deg = rng_roll.uniform(-180.0, 180.0);
   }
   if (s.from_motion && options.distance_spread_mm > 0.0) {
     s.options.depth_offset_mm = synth::Rng::stream(seed, index, kDistanceStream)

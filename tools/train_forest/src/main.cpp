@@ -243,6 +243,10 @@ int main(int argc, char** argv) {
                  "Motion images moved nearer or farther along their palm ray by up to this many mm (handtrack-synth "
                  "--depth-offset; default 0: where the motions hold the hand)")
       ->check(CLI::Range(0.0, 250.0));
+  app.add_option("--rolled-fraction", scene.rolled_fraction,
+                 "Share of the motion images seen through a camera rolled about its axis, by an angle uniform in "
+                 "[-180, 180] deg (handtrack-synth --roll: the forearm from any image edge)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--armless-fraction", scene.armless_fraction,
                  "Share of images whose hand is drawn without its arm, cut at the wrist (handtrack-synth --arm none)")
       ->check(CLI::Range(0.0, 1.0));
@@ -316,7 +320,7 @@ int main(int argc, char** argv) {
             << " --turned-fraction " << scene.turned_fraction << " --view-fraction " << scene.view_fraction
             << " --ball-fraction " << scene.ball_fraction << " --body-fraction " << scene.body_fraction
             << " --varied-fraction " << scene.varied_fraction << " --distance-spread-mm " << scene.distance_spread_mm
-            << " --armless-fraction " << scene.armless_fraction
+            << " --armless-fraction " << scene.armless_fraction << " --rolled-fraction " << scene.rolled_fraction
             << " --pose-far-mm " << scene.far_mm
             << " --volume-far-mm " << scene.volume_far_mm << " --probes " << probes << " --seed " << train.seed;
     const auto t1 = std::chrono::steady_clock::now();

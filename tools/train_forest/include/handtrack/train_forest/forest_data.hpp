@@ -74,6 +74,11 @@ struct SceneOptions {
   // renderer's hand model). Drawn from a stream of its own, so 0 leaves the data set unchanged
   // (docs/TRACKER.md, "A hand without its arm").
   double armless_fraction = 0.0;
+  // Share of the motion images seen through a camera rolled about its axis by an angle drawn
+  // uniformly from [-180, 180] deg (synth --roll): the forearm from any image edge. Drawn from a
+  // stream of its own, so 0 leaves the data set unchanged (docs/TRACKER.md, "The forearm from any
+  // image edge").
+  double rolled_fraction = 0.0;
   CameraIntrinsics camera = synth::default_camera();
 };
 
