@@ -551,30 +551,43 @@ TEST(PartForestTraining, VariedFractionVariesTheHandsAndNothingElse) {
       half, [](const forest::Scene& s) { return s.options.proportions == synth::Proportions::kVaried; });
 }
 
+// Scenes drawn with `with` (an option for the motion images) and without: each the same otherwise,
+// `value` 0 in the plain scenes and in the random poses; `visit` sees each motion scene's value.
+// Returns how many motion scenes there were.
+template <typename Value, typename Visit>
+int visit_motion_scenes(const forest::SceneOptions& with, const Value& value, const Visit& visit) {
+  const forest::SceneOptions none;
+  int motions = 0;
+  for (uint64_t i = 0; i < 200; ++i) {
+    const forest::Scene s = forest::make_scene(9, i, with);
+    const forest::Scene plain = forest::make_scene(9, i, none);
+    EXPECT_EQ(value(plain), 0.0);
+    expect_the_same_scene_otherwise(s, plain);
+    if (!s.from_motion) {
+      EXPECT_EQ(value(s), 0.0);
+      continue;
+    }
+    ++motions;
+    visit(value(s));
+  }
+  return motions;
+}
+
 TEST(PartForestTraining, DistanceSpreadMovesTheMotionImagesAndNothingElse) {
   // --distance-spread-mm: each motion image moved along its palm ray by an offset drawn from
   // [-spread, spread] (synth --depth-offset), from a stream of its own; the random poses and
   // everything else as without it.
   forest::SceneOptions spread;
   spread.distance_spread_mm = 100.0;
-  const forest::SceneOptions none;
-  int motions = 0;
   int nearer = 0;
   int farther = 0;
-  for (uint64_t i = 0; i < 200; ++i) {
-    const forest::Scene s = forest::make_scene(9, i, spread);
-    const forest::Scene plain = forest::make_scene(9, i, none);
-    EXPECT_EQ(plain.options.depth_offset_mm, 0.0);
-    expect_the_same_scene_otherwise(s, plain);
-    if (!s.from_motion) {
-      EXPECT_EQ(s.options.depth_offset_mm, 0.0);
-      continue;
-    }
-    ++motions;
-    EXPECT_LE(std::abs(s.options.depth_offset_mm), 100.0);
-    nearer += s.options.depth_offset_mm < -50.0 ? 1 : 0;
-    farther += s.options.depth_offset_mm > 50.0 ? 1 : 0;
-  }
+  const int motions = visit_motion_scenes(
+      spread, [](const forest::Scene& s) { return s.options.depth_offset_mm; },
+      [&](double offset) {
+        EXPECT_LE(std::abs(offset), 100.0);
+        nearer += offset < -50.0 ? 1 : 0;
+        farther += offset > 50.0 ? 1 : 0;
+      });
   EXPECT_GT(motions, 30);
   EXPECT_GT(nearer, motions / 8);
   EXPECT_GT(farther, motions / 8);
@@ -594,24 +607,15 @@ TEST(PartForestTraining, RolledFractionTurnsAShareOfTheMotionImagesAndNothingEls
   // already, and everything else as without it.
   forest::SceneOptions half;
   half.rolled_fraction = 0.5;
-  const forest::SceneOptions none;
-  int motions = 0;
   int rolled = 0;
   int beyond_quarter = 0;
-  for (uint64_t i = 0; i < 200; ++i) {
-    const forest::Scene s = forest::make_scene(9, i, half);
-    const forest::Scene plain = forest::make_scene(9, i, none);
-    EXPECT_EQ(plain.options.roll_deg, 0.0);
-    expect_the_same_scene_otherwise(s, plain);
-    if (!s.from_motion) {
-      EXPECT_EQ(s.options.roll_deg, 0.0);
-      continue;
-    }
-    ++motions;
-    EXPECT_LE(std::abs(s.options.roll_deg), 180.0);
-    rolled += s.options.roll_deg != 0.0 ? 1 : 0;
-    beyond_quarter += std::abs(s.options.roll_deg) > 90.0 ? 1 : 0;
-  }
+  const int motions = visit_motion_scenes(
+      half, [](const forest::Scene& s) { return s.options.roll_deg; },
+      [&](double roll) {
+        EXPECT_LE(std::abs(roll), 180.0);
+        rolled += roll != 0.0 ? 1 : 0;
+        beyond_quarter += std::abs(roll) > 90.0 ? 1 : 0;
+      });
   EXPECT_GT(motions, 30);
   EXPECT_GT(rolled, motions * 30 / 100);
   EXPECT_LT(rolled, motions * 70 / 100);
