@@ -121,15 +121,15 @@ const DepthInput& DepthInputBuilder::build(const DepthImage& depth, const std::o
   // there, so no part of the hand is in front of it).
   const bool desk = steps_->support_plane.find(config_.support_plane, out_.camera, out_.filtered_mm);
   if (desk) steps_->support_plane.erase(out_.camera, out_.filtered_mm);
-  if (hint && labeller != nullptr && labeller->turns_with_hand()) {
+  const bool segment_unhinted = hint && labeller != nullptr && labeller->turns_with_hand();
+  if (segment_unhinted) {
     DepthInput& unhinted = steps_->unhinted;
     unhinted.camera = out_.camera;
     unhinted.filtered_mm = out_.filtered_mm;  // same size every frame: no allocation after the first
     steps_->segmenter.segment(config_, median, std::nullopt, unhinted, foreign);
-    out_.unhinted_axis = unhinted.finger_axis;
   }
   steps_->segmenter.segment(config_, median, hint, out_, foreign);
-  if (!hint || labeller == nullptr || !labeller->turns_with_hand()) out_.unhinted_axis = out_.finger_axis;
+  out_.unhinted_axis = segment_unhinted ? steps_->unhinted.finger_axis : out_.finger_axis;
   const std::vector<float>* seen = &median;
   if (desk && config_.free_space.enabled) {
     steps_->without_desk = median;

@@ -260,7 +260,7 @@ int main(int argc, char** argv) {
   std::string probes = "image";
   app.add_option("--probes", probes,
                  "image (the paper's: offsets in the image's axes) or hand (offsets turned with the hand's in-plane "
-                 "axis, the segmentation's finger axis: a forearm from any image edge is probed alike)")
+                 "axis, the one the segmentation finds without a hint: a forearm from any image edge is probed alike)")
       ->check(CLI::IsMember({"image", "hand"}))
       ->capture_default_str();
   app.add_option("--seed", train.seed, "Seed of the data set and of the training");

@@ -131,7 +131,6 @@ struct ProbeSteps {
 inline ProbeSteps probe_steps(double focal_ratio_x, double focal_ratio_y, float depth_mm, const InPlaneTurn& turn) {
   const int32_t kx = probe_scale(focal_ratio_x, depth_mm);
   const int32_t ky = probe_scale(focal_ratio_y, depth_mm);
-  if (turn.cos == 1.0 && turn.sin == 0.0) return {kx, 0, 0, ky};
   const auto step = [](int32_t k, double c) { return static_cast<int32_t>(std::lround(k * c)); };
   return {step(kx, turn.cos), step(kx, -turn.sin), step(ky, turn.sin), step(ky, turn.cos)};
 }

@@ -30,7 +30,7 @@ struct TrainOptions {
   float max_offset_pxmm = 60.0F * static_cast<float>(SpecCamera::kFx);  // |u|, |v| per axis: 60 mm at the reference focal length
   float unary_fraction = 0.25F; // share of features with v = 0, i.e. f = d(x + u/d) - d(x)
   // Probes in the hand's frame (PartForestInfo::hand_aligned): each image's offsets turned by its
-  // LabelledImage::turn, as PartForest::label() turns them by the segmentation's finger axis.
+  // LabelledImage::turn, as PartForest::label() turns them by the segmentation's unhinted axis.
   bool hand_aligned = false;
   uint64_t seed = 1;
   int threads = 2;
