@@ -42,8 +42,9 @@ void fix_checksum(std::vector<uint8_t>& bytes) {
   std::memcpy(bytes.data() + bytes.size() - 8, &h, 8);
 }
 
-// A depth input of a flat square "hand" at `depth_mm` in the middle of the image.
-DepthInput square_input(int w, int h, float depth_mm, int half_side, double fx) {
+// A depth input of a flat rectangular "hand" at `depth_mm` in the middle of the image, 2 half_w x
+// 2 half_h pixels.
+DepthInput rectangle_input(int w, int h, float depth_mm, int half_w, int half_h, double fx) {
   DepthInput in;
   in.camera.width = w;
   in.camera.height = h;
@@ -52,14 +53,18 @@ DepthInput square_input(int w, int h, float depth_mm, int half_side, double fx) 
   in.camera.cy = h / 2.0;
   in.filtered_mm.assign(static_cast<size_t>(w) * h, 0.0F);
   in.hand_mask.assign(in.filtered_mm.size(), 0);
-  for (int y = h / 2 - half_side; y < h / 2 + half_side; ++y) {
-    for (int x = w / 2 - half_side; x < w / 2 + half_side; ++x) {
+  for (int y = h / 2 - half_h; y < h / 2 + half_h; ++y) {
+    for (int x = w / 2 - half_w; x < w / 2 + half_w; ++x) {
       in.filtered_mm[static_cast<size_t>(y) * w + x] = depth_mm;
       in.hand_mask[static_cast<size_t>(y) * w + x] = 1;
     }
   }
-  in.hand_pixels = 4 * half_side * half_side;
+  in.hand_pixels = 4 * half_w * half_h;
   return in;
+}
+
+DepthInput square_input(int w, int h, float depth_mm, int half_side, double fx) {
+  return rectangle_input(w, h, depth_mm, half_side, half_side, fx);
 }
 
 PartForestLeaf one_hot(int c) {
@@ -71,7 +76,9 @@ PartForestLeaf one_hot(int c) {
 // One stump: f = d(x + u / d(x)) - d(x) with u = (offset_pxmm, 0): a pixel whose probe to the right
 // leaves the hand reads the background (a large f) and goes right (class 2), others left (class 1).
 // Hand-aligned (PartForestInfo::hand_aligned): "to the right" is the hand's right, fingers up.
-PartForest right_edge_stump(int16_t offset_pxmm, float reference_fx, bool hand_aligned = false) {
+// `inside_sure`: the left leaf's probability of class 1 (the rest class 3); the right leaf is sure.
+PartForest right_edge_stump(int16_t offset_pxmm, float reference_fx, bool hand_aligned = false,
+                            double inside_sure = 1.0) {
   PartForestTree t;
   t.nodes.resize(3);
   t.nodes[0].u = {offset_pxmm, 0};
@@ -80,7 +87,10 @@ PartForest right_edge_stump(int16_t offset_pxmm, float reference_fx, bool hand_a
   t.nodes[0].child = 1;
   t.nodes[1].child = PartForestNode::kLeafBit | 0U;
   t.nodes[2].child = PartForestNode::kLeafBit | 1U;
-  t.leaves = {one_hot(1), one_hot(2)};
+  PartForestLeaf inside = one_hot(1);
+  inside[1] = static_cast<uint16_t>(std::lround(65535 * inside_sure));
+  inside[3] = static_cast<uint16_t>(65535 - inside[1]);
+  t.leaves = {inside, one_hot(2)};
   PartForestInfo info;
   info.reference_fx = info.reference_fy = reference_fx;
   info.hand_aligned = hand_aligned;
@@ -191,6 +201,53 @@ TEST(PartForestFeatures, AHandAlignedForestProbesInTheHandsFrame) {
   in.unhinted_axis = Eigen::Vector3d(1.0, 0.0, 0.0);
   EXPECT_EQ(label_at(aligned, 160, bottom), 2);
   EXPECT_EQ(label_at(aligned, 160, top), 1);
+}
+
+// The shipped forest is image-aligned. Where the hand's axis (DepthInput::finger_axis) points
+// nearer another image edge than the top, it labels the hand once more with its probes turned by
+// that quarter turn, and keeps the turned labels where its trees are surer of them (by 10 %). The
+// stump is sure (1.0) within its probe's reach of the hand's right edge and unsure (0.6) inside:
+// turned for fingers pointing to the image's left, "right" is the image's top. A rectangle 100 px
+// wide and 20 high has 200 sure pixels by its right edge and 1000 by its top: the turned labels
+// win. Stood on its end (20 x 100), the image's labels do.
+TEST(PartForestFeatures, AQuarterTurnIsKeptWhereTheTreesAreSurerOfIt) {
+  PartForest f = right_edge_stump(4000, 200.0F, false, 0.6);
+  const auto label_at = [&](const DepthInput& in, int x, int y) {
+    std::vector<uint8_t> labels;
+    f.label(in, labels);
+    return labels[static_cast<size_t>(y) * 320 + x];
+  };
+  DepthInput wide = rectangle_input(320, 240, 400.0F, 50, 10, 200.0);  // x in [110, 210), y in [110, 130)
+  DepthInput tall = rectangle_input(320, 240, 400.0F, 10, 50, 200.0);  // x in [150, 170), y in [70, 170)
+  const Eigen::Vector3d pointing_left(-1.0, 0.0, 0.0);
+  // Upright: labelled in the image's axes, the right edge's band sure.
+  EXPECT_EQ(label_at(wide, 205, 120), 2);
+  EXPECT_EQ(label_at(wide, 160, 112), 1);
+  wide.finger_axis = pointing_left;
+  EXPECT_EQ(label_at(wide, 205, 120), 1);
+  EXPECT_EQ(label_at(wide, 160, 112), 2);
+  tall.finger_axis = pointing_left;
+  EXPECT_EQ(label_at(tall, 165, 120), 2);
+  EXPECT_EQ(label_at(tall, 152, 72), 1);
+  // Within 45 deg of up: not turned.
+  wide.finger_axis = Eigen::Vector3d(-0.9, -1.0, 0.0);
+  EXPECT_EQ(label_at(wide, 205, 120), 2);
+  // Without quarter turns: the image's axes whatever the axis.
+  wide.finger_axis = pointing_left;
+  PartForestOptions plain{1};
+  plain.quarter_turns = false;
+  f.set_options(plain);
+  EXPECT_EQ(label_at(wide, 205, 120), 2);
+  EXPECT_EQ(label_at(wide, 160, 112), 1);
+  // The quarter of an axis: exact, the upright one at 45 deg and along the viewing ray.
+  const auto quarter = [](double x, double y, double z) { return quarter_turn(Eigen::Vector3d(x, y, z)); };
+  EXPECT_EQ(quarter(0.3, -1.0, 0.5).cos, 1.0);
+  EXPECT_EQ(quarter(1.0, -1.0, 0.0).cos, 1.0);
+  EXPECT_EQ(quarter(0.0, 0.0, 1.0).cos, 1.0);
+  EXPECT_EQ(quarter(-1.0, 0.2, 0.0).sin, -1.0);
+  EXPECT_EQ(quarter(1.0, 0.2, 0.0).sin, 1.0);
+  EXPECT_EQ(quarter(0.2, 1.0, 0.0).cos, -1.0);
+  EXPECT_EQ(quarter(0.2, 1.0, 0.0).sin, 0.0);
 }
 
 // A small trained model for the file tests (trained once per process).
