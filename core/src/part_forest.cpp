@@ -15,7 +15,7 @@ namespace {
 
 // How much surer the trees must be of a quarter turn's labels than of the image's (PartForest::
 // label). A rolled hand's turned labels are 20-40 % surer (seed 1, palm / back / head-mounted views
-// at 90 / 180 / -90 deg: mean max-class probability 0.48-0.63 -> 0.67-0.85). A hand that swings
+// at 90 / 180 / -90 deg: mean max-class probability 0.48-0.65 -> 0.67-0.85). A hand that swings
 // past 45 deg and back (the motion random), whose every roll the trees saw in the image's axes, is
 // about as sure either way, and taking the turned labels there cost 0.6 mm on random. 1.0 / 1.1 /
 // 1.2 measured on the rolled scenes and the benchmark's seeds 1-3, checked on seeds 4-6
