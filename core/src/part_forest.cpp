@@ -7,20 +7,21 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <numbers>
 #include <stdexcept>
 #include <string_view>
 
 namespace handtrack {
 namespace {
 
-// How much surer the trees must be of a quarter turn's labels than of the image's (PartForest::
+// How much surer the trees must be of a turned reading's labels than of the image's (PartForest::
 // label). A rolled hand's turned labels are 20-40 % surer (seed 1, palm / back / head-mounted views
 // at 90 / 180 / -90 deg: mean max-class probability 0.48-0.65 -> 0.67-0.85). A hand that swings
 // past 45 deg and back (the motion random), whose every roll the trees saw in the image's axes, is
 // about as sure either way, and taking the turned labels there cost 0.6 mm on random. 1.0 / 1.1 /
-// 1.2 measured on the rolled scenes and the benchmark's seeds 1-3, checked on seeds 4-6
-// (docs/FOREST.md, "A hand from another image edge").
-constexpr double kQuarterTurnMargin = 1.1;
+// 1.2 measured with quarter turns on the rolled scenes and the benchmark's seeds 1-3, checked on
+// seeds 4-6, and kept for the turns by 45 deg (docs/FOREST.md, "A hand from another image edge").
+constexpr double kTurnedReadingMargin = 1.1;
 
 static_assert(std::endian::native == std::endian::little, "the model file is read by memcpy: little-endian only");
 
@@ -444,7 +445,7 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
   // The hand's bounding box, copied with the background constant off the mask: probes then need
   // one bounds check, and the crop is small enough to stay in cache. Storage is per thread and
   // reused, with room for the whole image from a thread's first frame: a hand's box larger than
-  // any before must not allocate (the daemon's steady state). So too the labels of a quarter turn.
+  // any before must not allocate (the daemon's steady state). So too the labels of a turned reading.
   int x0 = w, y0 = h, x1 = -1, y1 = -1;
   for (int y = 0; y < h; ++y) {
     const uint8_t* row = mask + at(0, y);
@@ -479,15 +480,17 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
   }
   crop.depth_mm = crop_storage.data();
   const uint64_t sure = label_hand(input, crop, labels);
-  if (info_.hand_aligned || !options_.quarter_turns) return;
+  if (info_.hand_aligned || !options_.turned_readings) return;
 
-  // A hand from another image edge: the same sites with the probes turned by the axis' quarter
-  // turn. The turned labelling wins where the trees are surer of it by kQuarterTurnMargin, summed
-  // over the same sites. Upright hands (the axis within 45 deg of up) are labelled once.
-  crop.turn = quarter_turn(input.finger_axis);
+  // A hand from another image edge: the same sites with the probes turned by the axis' nearest
+  // multiple of 45 deg. The turned labelling wins where the trees are surer of it by
+  // kTurnedReadingMargin, summed over the same sites. Hands within 22.5 deg of up are labelled once.
+  crop.turn = eighth_turn(input.finger_axis);
   if (crop.turn.cos == 1.0) return;
   turned_labels.assign(n, 0);
-  if (static_cast<double>(label_hand(input, crop, turned_labels)) > kQuarterTurnMargin * static_cast<double>(sure)) std::copy(turned_labels.begin(), turned_labels.end(), labels.begin());
+  if (static_cast<double>(label_hand(input, crop, turned_labels)) > kTurnedReadingMargin * static_cast<double>(sure)) {
+    std::copy(turned_labels.begin(), turned_labels.end(), labels.begin());
+  }
 }
 
 uint64_t PartForest::label_hand(const DepthInput& input, const Crop& crop, std::vector<uint8_t>& labels) const {
@@ -571,11 +574,13 @@ InPlaneTurn hand_turn(const Eigen::Vector3d& finger_axis) {
   return {-finger_axis.y() / norm, finger_axis.x() / norm};
 }
 
-InPlaneTurn quarter_turn(const Eigen::Vector3d& finger_axis) {
+InPlaneTurn eighth_turn(const Eigen::Vector3d& finger_axis) {
   const InPlaneTurn t = hand_turn(finger_axis);
-  // The larger of |cos| and |sin| names the quarter; exactly at 45 deg the upright one.
-  if (std::abs(t.cos) >= std::abs(t.sin)) return {t.cos < 0.0 ? -1.0 : 1.0, 0.0};
-  return {0.0, t.sin < 0.0 ? -1.0 : 1.0};
+  constexpr double kHalf = 0.70710678118654752;  // cos 45 deg
+  static constexpr std::array<InPlaneTurn, 8> kEighths = {
+      {{1.0, 0.0}, {kHalf, kHalf}, {0.0, 1.0}, {-kHalf, kHalf}, {-1.0, 0.0}, {-kHalf, -kHalf}, {0.0, -1.0}, {kHalf, -kHalf}}};
+  const long k = std::lround(std::atan2(t.sin, t.cos) / (std::numbers::pi / 4.0));  // -4..4
+  return kEighths[static_cast<size_t>((k + 8) % 8)];
 }
 
 std::optional<std::filesystem::path> shipped_forest_path() {

@@ -538,16 +538,16 @@ TEST(HandFromAnyEdge, IsTrackedAsTheUprightHandGivenItsPartLabels) {
   }
 }
 
-// The shipped forest saw the motions upright only; it labels a rolled hand with its probes turned
-// by the quarter turn of the hand's axis where its trees are surer of those labels
-// (PartForestOptions::quarter_turns; docs/FOREST.md, "A hand from another image edge"). Measured
-// when written, frames 60-149 at 0 / 90 / 180 / -90 deg: 4.0 / 3.9 / 3.7 / 4.0 mm, every frame
-// right. Without the quarter turns: 4.0 / 11.2 / 14.7 / 7.5 mm, and at 180 and -90 deg the left
-// hand in every frame.
+// The shipped forest saw the motions upright only; it labels a rolled hand a second time with its
+// probes turned by the nearest multiple of 45 deg to the hand's axis, and keeps those labels where
+// its trees are surer of them (PartForestOptions::turned_readings; docs/FOREST.md, "A hand from
+// another image edge"). Measured when written, frames 60-149 at 0 / 45 / 90 / 180 / -90 / -135
+// deg: 4.0 / 3.7 / 3.9 / 3.7 / 4.0 / 3.9 mm, every frame right. Without the turned readings: 4.0 /
+// 17.4 / 11.2 / 14.7 / 7.5 / 12.3 mm, and at 180, -90 and -135 deg the left hand in every frame.
 TEST(HandFromAnyEdge, IsTrackedNearlyAsTheUprightHandWithTheShippedForest) {
   const PartForest& forest = testing::shipped_forest();
   const double upright_mm = track_rolled("adbadd", 0.0, &forest).started_mm;
-  for (const double roll : {90.0, 180.0, -90.0}) {
+  for (const double roll : {45.0, 90.0, 180.0, -90.0, -135.0}) {
     const RolledRun rolled = track_rolled("adbadd", roll, &forest);
     EXPECT_EQ(rolled.run.posed, 150) << "rolled " << roll;
     EXPECT_GE(rolled.run.reported_as_shown, 147) << "rolled " << roll;

@@ -203,14 +203,14 @@ TEST(PartForestFeatures, AHandAlignedForestProbesInTheHandsFrame) {
   EXPECT_EQ(label_at(aligned, 160, top), 1);
 }
 
-// The shipped forest is image-aligned. Where the hand's axis (DepthInput::finger_axis) points
-// nearer another image edge than the top, it labels the hand once more with its probes turned by
-// that quarter turn, and keeps the turned labels where its trees are surer of them (by 10 %). The
+// The shipped forest is image-aligned. Where the hand's axis (DepthInput::finger_axis) is more than
+// 22.5 deg from the image's up, it labels the hand once more with its probes turned by the nearest
+// multiple of 45 deg, and keeps the turned labels where its trees are surer of them (by 10 %). The
 // stump is sure (1.0) within its probe's reach of the hand's right edge and unsure (0.6) inside:
 // turned for fingers pointing to the image's left, "right" is the image's top. A rectangle 100 px
 // wide and 20 high has 200 sure pixels by its right edge and 1000 by its top: the turned labels
 // win. Stood on its end (20 x 100), the image's labels do.
-TEST(PartForestFeatures, AQuarterTurnIsKeptWhereTheTreesAreSurerOfIt) {
+TEST(PartForestFeatures, ATurnedReadingIsKeptWhereTheTreesAreSurerOfIt) {
   PartForest f = right_edge_stump(4000, 200.0F, false, 0.6);
   const auto label_at = [&](const DepthInput& in, int x, int y) {
     std::vector<uint8_t> labels;
@@ -229,25 +229,42 @@ TEST(PartForestFeatures, AQuarterTurnIsKeptWhereTheTreesAreSurerOfIt) {
   tall.finger_axis = pointing_left;
   EXPECT_EQ(label_at(tall, 165, 120), 2);
   EXPECT_EQ(label_at(tall, 152, 72), 1);
-  // Within 45 deg of up: not turned.
-  wide.finger_axis = Eigen::Vector3d(-0.9, -1.0, 0.0);
+  // Within 22.5 deg of up: not turned.
+  wide.finger_axis = Eigen::Vector3d(-0.4, -1.0, 0.0);
   EXPECT_EQ(label_at(wide, 205, 120), 2);
-  // Without quarter turns: the image's axes whatever the axis.
+  // Without turned readings: the image's axes whatever the axis.
   wide.finger_axis = pointing_left;
   PartForestOptions plain{1};
-  plain.quarter_turns = false;
+  plain.turned_readings = false;
   f.set_options(plain);
   EXPECT_EQ(label_at(wide, 205, 120), 2);
   EXPECT_EQ(label_at(wide, 160, 112), 1);
-  // The quarter of an axis: exact, the upright one at 45 deg and along the viewing ray.
-  const auto quarter = [](double x, double y, double z) { return quarter_turn(Eigen::Vector3d(x, y, z)); };
-  EXPECT_EQ(quarter(0.3, -1.0, 0.5).cos, 1.0);
-  EXPECT_EQ(quarter(1.0, -1.0, 0.0).cos, 1.0);
-  EXPECT_EQ(quarter(0.0, 0.0, 1.0).cos, 1.0);
-  EXPECT_EQ(quarter(-1.0, 0.2, 0.0).sin, -1.0);
-  EXPECT_EQ(quarter(1.0, 0.2, 0.0).sin, 1.0);
-  EXPECT_EQ(quarter(0.2, 1.0, 0.0).cos, -1.0);
-  EXPECT_EQ(quarter(0.2, 1.0, 0.0).sin, 0.0);
+}
+
+// The turn of a reading: the axis' direction rounded to the nearest multiple of 45 deg, exact at
+// the quarter turns, none for an axis near up or along the viewing ray.
+TEST(PartForestFeatures, ATurnedReadingTurnsByTheNearestMultipleOf45Degrees) {
+  const auto turn = [](double x, double y, double z) { return eighth_turn(Eigen::Vector3d(x, y, z)); };
+  const auto expect_turn = [](const InPlaneTurn& t, double cos, double sin) {
+    EXPECT_NEAR(t.cos, cos, 1e-15);
+    EXPECT_NEAR(t.sin, sin, 1e-15);
+  };
+  const double half = std::sqrt(0.5);
+  expect_turn(turn(0.3, -1.0, 0.5), 1.0, 0.0);   // 17 deg right of up
+  expect_turn(turn(0.0, 0.0, 1.0), 1.0, 0.0);    // along the ray
+  expect_turn(turn(0.5, -1.0, 0.0), half, half);  // 27 deg: the hand's axis up and to the right
+  expect_turn(turn(1.0, -1.0, 0.0), half, half);
+  expect_turn(turn(-1.0, 0.2, 0.0), 0.0, -1.0);  // pointing left
+  expect_turn(turn(1.0, 0.2, 0.0), 0.0, 1.0);    // pointing right
+  expect_turn(turn(0.2, 1.0, 0.0), -1.0, 0.0);   // pointing down
+  expect_turn(turn(-1.0, 1.0, 0.0), -half, -half);
+  // Exact where a quarter turn reads whole pixels.
+  EXPECT_EQ(turn(-1.0, 0.2, 0.0).cos, 0.0);
+  EXPECT_EQ(turn(0.2, 1.0, 0.0).sin, 0.0);
+  // The turn is hand_turn's: fingers to the image's right read "up the hand" to the right.
+  const ProbeSteps steps = probe_steps(1.0, 1.0, 256.0F, turn(1.0, 0.2, 0.0));
+  EXPECT_EQ(probe_coordinate(10, 0, -2560, steps.xx, steps.xy), 20);
+  EXPECT_EQ(probe_coordinate(10, 0, -2560, steps.yx, steps.yy), 10);
 }
 
 // A small trained model for the file tests (trained once per process).

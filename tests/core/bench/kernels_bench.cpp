@@ -91,8 +91,8 @@ void BM_Preprocess(benchmark::State& state) {
 }
 BENCHMARK(BM_Preprocess)->ArgName("forest")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
-// quarter 1: the hand's axis taken to point at the image's left edge, so that every frame is also
-// labelled with its probes turned by a quarter turn (PartForestOptions::quarter_turns): the cost
+// turned 1: the hand's axis taken to point at the image's left edge, so that every frame is also
+// labelled with its probes turned by a quarter turn (PartForestOptions::turned_readings): the cost
 // of a hand from another image edge.
 void BM_ForestLabels(benchmark::State& state) {
   const PartForest* f = forest(state);
@@ -110,7 +110,7 @@ void BM_ForestLabels(benchmark::State& state) {
     i = (i + 1) % inputs.size();
   }
 }
-BENCHMARK(BM_ForestLabels)->ArgName("quarter")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ForestLabels)->ArgName("turned")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 // E_free's map of one frame (free_space.hpp): the hand's box and depth range, the cells marked
 // free or not, the distance transform. Part of BM_Preprocess.

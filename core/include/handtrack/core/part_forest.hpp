@@ -16,8 +16,8 @@
 // probed as one whose fingers point up the image. Its training images are turned alike
 // (train_forest), and the trees need not learn every roll of every part. The tracked pose's axis
 // (the hint's) is not the one trained on: with it, tracking lost 0.7 mm (docs/FOREST.md).
-// An image-aligned forest (the shipped one) turns its probes by quarter turns only, and only where
-// the trees are surer of the turned labels (PartForestOptions::quarter_turns).
+// An image-aligned forest (the shipped one) turns its probes by multiples of 45 deg only, and only
+// where the trees are surer of the turned labels (PartForestOptions::turned_readings).
 // A pixel goes left when f < threshold. Its class distribution is the mean of the trees' leaf
 // distributions (Criminisi and Shotton 2013); the label is the argmax.
 //
@@ -101,11 +101,11 @@ struct PartForestOptions {
   // no longer back within 30 frames (docs/FOREST.md).
   int stride_px = 3;
   // An image-aligned forest saw the motions with the forearm from the image bottom only. Where the
-  // hand's axis (DepthInput::finger_axis: the tracked pose's, or the segmentation's) points nearer
-  // another image edge than the top, label() labels the hand a second time with its probes turned
-  // by that quarter turn (quarter_turn), and keeps the labelling its trees are surer of (ours;
-  // docs/FOREST.md, "A hand from another image edge").
-  bool quarter_turns = true;
+  // hand's axis (DepthInput::finger_axis: the tracked pose's, or the segmentation's) is more than
+  // 22.5 deg from the image's up, label() labels the hand a second time with its probes turned by
+  // the nearest multiple of 45 deg (eighth_turn), and keeps the labelling its trees are surer of
+  // (ours; docs/FOREST.md, "A hand from another image edge").
+  bool turned_readings = true;
 };
 
 // Probe arithmetic, shared by training and inference so that both round alike, in 16.16 fixed
@@ -126,9 +126,9 @@ struct InPlaneTurn {
   double sin = 0.0;
 };
 InPlaneTurn hand_turn(const Eigen::Vector3d& finger_axis);
-// hand_turn rounded to the nearest quarter turn (0, 90, 180 or 270 deg; exact), the identity for an
-// axis within 45 deg of the image's up or along the viewing ray.
-InPlaneTurn quarter_turn(const Eigen::Vector3d& finger_axis);
+// hand_turn rounded to the nearest multiple of 45 deg (cos and sin exact at the quarter turns), the
+// identity for an axis less than 22.5 deg from the image's up or along the viewing ray.
+InPlaneTurn eighth_turn(const Eigen::Vector3d& finger_axis);
 
 // A pixel's probe steps in 16.16: an offset (u_x, u_y) reads pixel
 // (x + round((xx u_x + xy u_y) / 65536), y + round((yx u_x + yy u_y) / 65536)), the turn applied
