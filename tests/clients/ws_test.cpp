@@ -299,7 +299,10 @@ TEST_F(WsBridge, ThePageDrawsTheMovingHandInChromium) {
   Child browser({chromium, "--headless=new", "--no-sandbox", "--disable-gpu", "--no-first-run",
                  "--remote-debugging-port=0", "--user-data-dir=" + profile.path().string(), "--window-size=800,520",
                  bridge->origin() + "/"},
-                profile / "out", profile / "err");
+                profile / "out", profile / "err",
+                // Its own temporary files (a singleton socket directory that a killed Chromium leaves
+                // behind) in the profile, removed with it.
+                {"TMPDIR=" + profile.path().string()});
   // Chromium writes its DevTools port into the profile.
   unsigned short port = 0;
   for (int i = 0; i < 300 && port == 0; ++i) {
