@@ -3,12 +3,16 @@
 
     gray_png.py mirror IN.png OUT.png
     gray_png.py shift DX DY IN.png OUT.png
+    gray_png.py upside-down IN.png OUT.png
 
 A depth frame mirrored left to right, with the principal point at cx' = (width - 1) - cx, shows a
 left hand where the frame showed a right one (docs/TRACKER.md, "Left hands"). Shifted by whole
 pixels (pixel (u, v) moves to (u + DX, v + DY), the uncovered border reads 0: no depth), with the
-principal point at (cx + DX, cy + DY), it shows the same scene on a pixel grid moved under it. What
-scripts/eval-real-still makes of the SR305's right hands.
+principal point at (cx + DX, cy + DY), it shows the same scene on a pixel grid moved under it.
+Turned upside down (mirrored left to right and top to bottom: a half turn about the optical axis),
+with the principal point at ((width - 1) - cx, (height - 1) - cy), it shows the same hand, still a
+right one, through a camera mounted upside down. What scripts/eval-real-still makes of the SR305's
+right hands.
 """
 import struct
 import sys
@@ -74,6 +78,10 @@ def mirrored(width, bpp, rows):
     return [b"".join(row[x * bpp:(x + 1) * bpp] for x in reversed(range(width))) for row in rows]
 
 
+def upside_down(width, bpp, rows):
+    return list(reversed(mirrored(width, bpp, rows)))
+
+
 def shifted(width, height, bpp, rows, dx, dy):
     blank = bytes(width * bpp)
     out = []
@@ -92,6 +100,9 @@ def main():
     if len(args) == 3 and args[0] == "mirror":
         width, height, depth, rows = read_gray(args[1])
         write_gray(args[2], width, height, depth, mirrored(width, depth // 8, rows))
+    elif len(args) == 3 and args[0] == "upside-down":
+        width, height, depth, rows = read_gray(args[1])
+        write_gray(args[2], width, height, depth, upside_down(width, depth // 8, rows))
     elif len(args) == 5 and args[0] == "shift":
         try:
             dx, dy = int(args[1]), int(args[2])
@@ -100,7 +111,8 @@ def main():
         width, height, depth, rows = read_gray(args[3])
         write_gray(args[4], width, height, depth, shifted(width, height, depth // 8, rows, dx, dy))
     else:
-        sys.exit("usage: gray_png.py mirror IN.png OUT.png | gray_png.py shift DX DY IN.png OUT.png")
+        sys.exit("usage: gray_png.py mirror IN.png OUT.png | gray_png.py shift DX DY IN.png OUT.png | "
+                 "gray_png.py upside-down IN.png OUT.png")
 
 
 if __name__ == "__main__":
