@@ -729,22 +729,27 @@ TEST(ShippedPartForest, LoadsAndLabelsHeldOutSyntheticHandsAtLeast60PercentRight
   for (int c = 1; c < kPartForestClasses; ++c) EXPECT_GT(r.overall.class_recall(c), 0.25) << "class " << c;
 }
 
+// The forest's labels of every 50th frame of a rendered sequence, scored against the rendered ones.
+forest::Confusion scored_frames(const PartForest& model, const synth::SynthOptions& options) {
+  synth::SyntheticCamera cam(options);
+  DepthInputBuilder builder;
+  synth::SynthFrame f;
+  forest::Confusion c;
+  std::vector<uint8_t> scratch;
+  for (int i = 0; i < options.frames; i += 50) {
+    cam.render(i, f);
+    c.add(forest::score_frame(model, builder.build(f.depth, std::nullopt), f.labels.pixels, scratch));
+  }
+  return c;
+}
+
 TEST(ShippedPartForest, WorksAtOtherResolutions) {
   const PartForest model = PartForest::load(kShippedModel);
   synth::SynthOptions o;
   o.motion = "fingerwave";
   o.seed = 31337;
   o.camera = synth::default_camera(640, 480);
-  synth::SyntheticCamera cam(o);
-  DepthInputBuilder builder;
-  synth::SynthFrame f;
-  forest::Confusion c;
-  std::vector<uint8_t> scratch;
-  for (int i = 0; i < 300; i += 50) {
-    cam.render(i, f);
-    const DepthInput& in = builder.build(f.depth, std::nullopt);
-    c.add(forest::score_frame(model, in, f.labels.pixels, scratch));
-  }
+  const forest::Confusion c = scored_frames(model, o);
   EXPECT_GE(c.accuracy(), 0.60) << c.table();
 }
 
@@ -764,16 +769,7 @@ TEST(ShippedPartForest, ReadsARolledHandAsWellAsAnUprightOne) {
     o.motion = "pinch";
     o.seed = 31337;
     o.roll_deg = roll_deg;
-    synth::SyntheticCamera cam(o);
-    DepthInputBuilder builder;
-    synth::SynthFrame f;
-    forest::Confusion c;
-    std::vector<uint8_t> scratch;
-    for (int i = 0; i < 300; i += 50) {
-      cam.render(i, f);
-      c.add(forest::score_frame(model, builder.build(f.depth, std::nullopt), f.labels.pixels, scratch));
-    }
-    return c.accuracy();
+    return scored_frames(model, o).accuracy();
   };
   const double upright = accuracy(turned, 0.0);
   EXPECT_EQ(upright, accuracy(plain, 0.0));  // within 22.5 deg of up: read once, as before
