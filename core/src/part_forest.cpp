@@ -23,6 +23,19 @@ namespace {
 // seeds 4-6, and kept for the turns by 45 deg (docs/FOREST.md, "A hand from another image edge").
 constexpr double kTurnedReadingMargin = 1.1;
 
+// The pixels of an input's images (row-major, the camera's width) and which of them the forest
+// labels: on the hand mask, with a depth.
+struct HandPixels {
+  const DepthInput& input;
+  [[nodiscard]] size_t at(int x, int y) const {
+    return static_cast<size_t>(y) * static_cast<size_t>(input.camera.width) + static_cast<size_t>(x);
+  }
+  [[nodiscard]] bool labelled(int x, int y) const {
+    const size_t i = at(x, y);
+    return input.hand_mask[i] != 0 && input.filtered_mm[i] > 0.0F;
+  }
+};
+
 static_assert(std::endian::native == std::endian::little, "the model file is read by memcpy: little-endian only");
 
 constexpr std::array<char, 8> kMagic = {'H', 'T', 'F', 'O', 'R', 'E', 'S', 'T'};
@@ -439,8 +452,7 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
   labels.assign(n, 0);
   if (n == 0 || input.hand_mask.size() != n || input.filtered_mm.size() != n) return;
   const auto* mask = input.hand_mask.data();
-  const auto at = [w](int x, int y) { return static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x); };
-  const auto usable = [&](size_t i) { return mask[i] != 0 && input.filtered_mm[i] > 0.0F; };
+  const HandPixels pixels{input};
 
   // The hand's bounding box, copied with the background constant off the mask: probes then need
   // one bounds check, and the crop is small enough to stay in cache. Storage is per thread and
@@ -448,12 +460,12 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
   // any before must not allocate (the daemon's steady state). So too the labels of a turned reading.
   int x0 = w, y0 = h, x1 = -1, y1 = -1;
   for (int y = 0; y < h; ++y) {
-    const uint8_t* row = mask + at(0, y);
+    const uint8_t* row = mask + pixels.at(0, y);
     uint8_t any = 0;
     for (int x = 0; x < w; ++x) any |= row[x];  // most rows have no hand: one vectorised pass
     if (any == 0) continue;
     for (int x = 0; x < w; ++x) {
-      if (!usable(at(x, y))) continue;
+      if (!pixels.labelled(x, y)) continue;
       x0 = std::min(x0, x);
       x1 = std::max(x1, x);
       y0 = std::min(y0, y);
@@ -476,7 +488,7 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
   crop_storage.resize(static_cast<size_t>(crop.width) * static_cast<size_t>(crop.height));
   for (int y = y0; y <= y1; ++y) {
     float* row = crop_storage.data() + static_cast<size_t>(y - y0) * static_cast<size_t>(crop.width);
-    for (int x = x0; x <= x1; ++x) row[x - x0] = usable(at(x, y)) ? input.filtered_mm[at(x, y)] : info_.background_mm;
+    for (int x = x0; x <= x1; ++x) row[x - x0] = pixels.labelled(x, y) ? input.filtered_mm[pixels.at(x, y)] : info_.background_mm;
   }
   crop.depth_mm = crop_storage.data();
   const uint64_t sure = label_hand(input, crop, labels);
@@ -496,9 +508,7 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
 uint64_t PartForest::label_hand(const DepthInput& input, const Crop& crop, std::vector<uint8_t>& labels) const {
   const int w = input.camera.width;
   const int h = input.camera.height;
-  const auto* mask = input.hand_mask.data();
-  const auto at = [w](int x, int y) { return static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x); };
-  const auto usable = [&](size_t i) { return mask[i] != 0 && input.filtered_mm[i] > 0.0F; };
+  const HandPixels pixels{input};
   const int stride = options_.stride_px * std::max(1, w / 320);
   const int x0 = crop.x0;
   const int y0 = crop.y0;
@@ -516,12 +526,12 @@ uint64_t PartForest::label_hand(const DepthInput& input, const Crop& crop, std::
       const Site& s = sites[static_cast<size_t>(p)];
       const uint8_t l = classes[static_cast<size_t>(p)];
       if (stride == 1) {
-        labels[at(s.x, s.y)] = l;
+        labels[pixels.at(s.x, s.y)] = l;
         continue;
       }
       for (int y = s.block_y; y < std::min(h, s.block_y + stride); ++y) {
         for (int x = s.block_x; x < std::min(w, s.block_x + stride); ++x) {
-          if (usable(at(x, y))) labels[at(x, y)] = l;
+          if (pixels.labelled(x, y)) labels[pixels.at(x, y)] = l;
         }
       }
     }
@@ -534,7 +544,7 @@ uint64_t PartForest::label_hand(const DepthInput& input, const Crop& crop, std::
   if (stride == 1) {
     for (int y = y0; y <= y1; ++y) {
       for (int x = x0; x <= x1; ++x) {
-        if (usable(at(x, y))) add(x, y, x, y);
+        if (pixels.labelled(x, y)) add(x, y, x, y);
       }
     }
   } else {
@@ -546,11 +556,11 @@ uint64_t PartForest::label_hand(const DepthInput& input, const Crop& crop, std::
         const int xe = std::min(w, bx + stride);
         int sx = std::min(bx + stride / 2, xe - 1);
         int sy = std::min(by + stride / 2, ye - 1);
-        if (!usable(at(sx, sy))) {
+        if (!pixels.labelled(sx, sy)) {
           sx = -1;
           for (int y = by; y < ye && sx < 0; ++y) {
             for (int x = bx; x < xe; ++x) {
-              if (usable(at(x, y))) {
+              if (pixels.labelled(x, y)) {
                 sx = x;
                 sy = y;
                 break;
