@@ -88,13 +88,21 @@ constexpr double kMaxDepthOffsetMm = 250.0;
 // The palm's half thickness (its pieces' radii, hand_model.cpp): a held ball rests on its surface.
 constexpr double kPalmHalfThicknessMm = 13.5;
 
-// A ball of radius r held against the palm: its centre r beyond the palm's surface along the
-// palmar normal (+z of the hand frame: toward the camera when the palm faces it), opposite the
-// palm centre.
-ConeSphere held_ball(const HandShape& shape, const HandPose& pose, double r) {
-  const Vector3d in_hand = shape.palm_centre_mm + Vector3d(0.0, 0.0, kPalmHalfThicknessMm + r);
-  const Vector3d c = pose.translation_mm + camera_R_hand(pose.rotation) * in_hand;
-  return ConeSphere{c, c, r, r, kBackground};
+// Half the length of a held bottle's axis, between the centres of its round ends.
+constexpr double kBottleHalfAxisMm = 65.0;
+
+// The object held against the palm, if any: a ball of radius r, its centre r beyond the palm's
+// surface along the palmar normal (+z of the hand frame: toward the camera when the palm faces it),
+// opposite the palm centre; or a bottle of radius r there, its axis along the palm's width (x of
+// the hand frame).
+std::optional<ConeSphere> held_object(const HandShape& shape, const HandPose& pose, const SynthOptions& options) {
+  const bool bottle = options.bottle_radius_mm > 0.0;
+  const double r = bottle ? options.bottle_radius_mm : options.ball_radius_mm;
+  if (!(r > 0.0)) return std::nullopt;
+  const Eigen::Matrix3d R = camera_R_hand(pose.rotation);
+  const Vector3d c = pose.translation_mm + R * (shape.palm_centre_mm + Vector3d(0.0, 0.0, kPalmHalfThicknessMm + r));
+  const Vector3d half_axis = bottle ? Vector3d(R.col(0) * kBottleHalfAxisMm) : Vector3d::Zero();
+  return ConeSphere{c - half_axis, c + half_axis, r, r, kBackground};
 }
 
 // The one of `values` that `name_of` names `name`.
@@ -259,6 +267,7 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   // What only a scene of one hand has: a two-hand motion places both hands itself.
   const char* one_hand_only = options.background == Background::kDesk ? "the desk background"
                               : options.ball_radius_mm > 0.0          ? "a held ball"
+                              : options.bottle_radius_mm > 0.0        ? "a held bottle"
                               : options.depth_offset_mm != 0.0        ? "a depth offset"
                               : options.arm == Arm::kShoulder         ? "the upper arm"
                               : options.arm == Arm::kNone             ? "a hand without its arm"
@@ -269,6 +278,12 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   }
   if (!(options.ball_radius_mm >= 0.0 && options.ball_radius_mm <= kMaxBallRadiusMm)) {
     throw std::invalid_argument("ball radius must be within [0, 100] mm");
+  }
+  if (!(options.bottle_radius_mm >= 0.0 && options.bottle_radius_mm <= kMaxBallRadiusMm)) {
+    throw std::invalid_argument("bottle radius must be within [0, 100] mm");
+  }
+  if (options.ball_radius_mm > 0.0 && options.bottle_radius_mm > 0.0) {
+    throw std::invalid_argument("one held object at a time: a ball or a bottle");
   }
   if (!(std::abs(options.depth_offset_mm) <= kMaxDepthOffsetMm)) {
     throw std::invalid_argument("depth offset must be within [-250, 250] mm");
@@ -440,7 +455,7 @@ void SyntheticCamera::render_pose(const HandPose& pose, int frame, SynthFrame& o
   posed_primitives(shape, out.pose, out.joints, s.primitives);
   s.raycaster = s.background;  // same sizes: no allocation
   for (const auto& p : s.primitives) s.raycaster.draw(p);
-  if (s.options.ball_radius_mm > 0.0) s.raycaster.draw(held_ball(shape, out.pose, s.options.ball_radius_mm));
+  if (const auto held = held_object(shape, out.pose, s.options)) s.raycaster.draw(*held);
   if (s.options.background == Background::kDesk) {
     // The hand and the forearm rest on it; the upper arm, posed last, rises from it to the shoulder.
     const size_t resting = s.primitives.size() - (shape.upper_arm_camera_direction ? 1 : 0);

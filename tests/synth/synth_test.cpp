@@ -310,6 +310,48 @@ TEST(SynthScenes, ADeskUnderTheHandAndABallInIt) {
   EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);  // the desk is for one-hand motions
 }
 
+TEST(SynthScenes, ABottleHeldAcrossThePalmReachesPastBothSidesOfTheHand) {
+  // A bottle (SynthOptions::bottle_radius_mm) lies across the palm: it covers palm pixels (label 0,
+  // nearer than the palm was), and along the image row through the palm centre it shows on both
+  // sides of the hand, where the frame without it has no hand.
+  SynthOptions plain = clean_options("pinch");
+  SynthOptions bottle = plain;
+  bottle.bottle_radius_mm = 30.0;
+  const SynthFrame a = SyntheticCamera(plain).render(60);
+  const SynthFrame b = SyntheticCamera(bottle).render(60);
+  const int w = a.depth.camera.width;
+  size_t covered = 0;
+  for (size_t i = 0; i < a.depth.depth_mm.size(); ++i) {
+    const bool over_palm = a.labels.pixels[i] == handtrack::kPalm && b.labels.pixels[i] == 0;
+    covered += over_palm && b.depth.depth_mm[i] < a.depth.depth_mm[i] ? 1 : 0;
+  }
+  EXPECT_GT(covered, 500u);
+  // The row of the palm pixels' centroid: the hand's extent in it, and the bottle's nearer pixels.
+  double v_sum = 0.0;
+  size_t palm = 0;
+  for (size_t i = 0; i < a.labels.pixels.size(); ++i) {
+    if (a.labels.pixels[i] != handtrack::kPalm) continue;
+    v_sum += static_cast<double>(i / w);
+    ++palm;
+  }
+  ASSERT_GT(palm, 0u);
+  const auto row = static_cast<size_t>(v_sum / static_cast<double>(palm));
+  int hand_lo = w, hand_hi = -1, bottle_lo = w, bottle_hi = -1;
+  for (int u = 0; u < w; ++u) {
+    const size_t i = row * w + static_cast<size_t>(u);
+    if (a.labels.pixels[i] != 0) hand_lo = std::min(hand_lo, u), hand_hi = std::max(hand_hi, u);
+    const bool nearer = b.depth.depth_mm[i] > 0 && (a.depth.depth_mm[i] == 0 || b.depth.depth_mm[i] < a.depth.depth_mm[i] - 20);
+    if (b.labels.pixels[i] == 0 && nearer) bottle_lo = std::min(bottle_lo, u), bottle_hi = std::max(bottle_hi, u);
+  }
+  EXPECT_LT(bottle_lo, hand_lo);
+  EXPECT_GT(bottle_hi, hand_hi);
+  SynthOptions both = bottle;
+  both.ball_radius_mm = 30.0;
+  EXPECT_THROW(SyntheticCamera{both}, std::invalid_argument);  // one held object at a time
+  bottle.bottle_radius_mm = 150.0;
+  EXPECT_THROW(SyntheticCamera{bottle}, std::invalid_argument);
+}
+
 TEST(SynthScenes, ANearBodyIsInsideTheWorkingVolumeBehindTheHand) {
   // Background::kNearBody: what is not the hand (label 0: the forearm, torso and head) covers more
   // of the tracker's 150-600 mm working volume than a hand and forearm can (400 cm^2); with the

@@ -676,6 +676,31 @@ TEST(PartForestTraining, ArmlessFractionDrawsThatShareWithoutTheArmAndNothingEls
   expect_half_changed_and_nothing_else(half, [](const forest::Scene& s) { return s.options.arm == synth::Arm::kNone; });
 }
 
+TEST(PartForestTraining, BottleShareHoldsABottleInsteadOfABallInThatShareAndNothingElse) {
+  // --bottle-share: of the images with a held object, about that share hold a bottle (synth
+  // --bottle) of the radius the ball would have had, from a stream of its own; everything else as
+  // with balls alone.
+  forest::SceneOptions balls;
+  balls.ball_fraction = 1.0;
+  forest::SceneOptions half = balls;
+  half.bottle_share = 0.5;
+  constexpr int kScenes = 200;
+  int bottles = 0;
+  for (uint64_t i = 0; i < kScenes; ++i) {
+    const forest::Scene s = forest::make_scene(9, i, half);
+    const forest::Scene plain = forest::make_scene(9, i, balls);
+    expect_the_same_scene_otherwise(s, plain);
+    EXPECT_GT(plain.options.ball_radius_mm, 0.0);
+    EXPECT_EQ(plain.options.bottle_radius_mm, 0.0);
+    const bool bottle = s.options.bottle_radius_mm > 0.0;
+    EXPECT_EQ(bottle ? s.options.bottle_radius_mm : s.options.ball_radius_mm, plain.options.ball_radius_mm);
+    EXPECT_EQ(bottle ? s.options.ball_radius_mm : s.options.bottle_radius_mm, 0.0);  // one object
+    bottles += bottle ? 1 : 0;
+  }
+  EXPECT_GT(bottles, kScenes * 35 / 100);
+  EXPECT_LT(bottles, kScenes * 65 / 100);
+}
+
 TEST(PartForestTraining, RolledFractionTurnsAShareOfTheMotionImagesAndNothingElse) {
   // --rolled-fraction: a share of the motion images seen through a camera rolled by an angle drawn
   // from [-180, 180] deg (synth --roll), from a stream of its own; the random poses, which roll

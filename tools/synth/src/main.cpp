@@ -97,6 +97,7 @@ void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticC
                       {"noise_sigma_k_per_mm", o.noise_params.sigma_k_per_mm},
                       {"background", std::string(handtrack::synth::background_name(o.background))},
                       {"ball_radius_mm", o.ball_radius_mm},
+                      {"bottle_radius_mm", o.bottle_radius_mm},
                       {"proportions", std::string(handtrack::synth::proportions_name(o.proportions))},
                       {"arm", std::string(handtrack::synth::arm_name(o.arm))},
                       {"roll_deg", o.roll_deg},
@@ -220,6 +221,12 @@ int main(int argc, char** argv) {
   double ball_radius_mm = 0.0;
   app.add_option("--ball", ball_radius_mm, "Radius (mm) of a ball held against the palm (default 0: none)")
       ->check(CLI::Range(0.0, 100.0));
+  double bottle_radius_mm = 0.0;
+  app.add_option("--bottle", bottle_radius_mm,
+                 "Radius (mm) of a bottle (its axis 130 mm long) held against the palm across its width, an object "
+                 "the forest never saw (default 0: none; not with --ball)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->excludes("--ball");
   app.add_option("--hand", hand, "right (default) or left: the right hand's exact mirror image (not with a "
                                  "two-hand motion: it shows both)");
   app.add_option("--view", view, "Camera arrangement (see --list-views): palm (default), back, side, "
@@ -297,6 +304,7 @@ int main(int argc, char** argv) {
     options.frames = frames;
     options.background = *bg;
     options.ball_radius_mm = ball_radius_mm;
+    options.bottle_radius_mm = bottle_radius_mm;
     options.hand = *handedness;
     options.proportions = *shape_proportions;
     options.arm = *shown_arm;

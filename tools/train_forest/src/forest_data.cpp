@@ -18,12 +18,13 @@ constexpr uint64_t kProportionStream = 0x960B0;  // ... and of SceneOptions::var
 constexpr uint64_t kDistanceStream = 0xD157;      // ... and of SceneOptions::distance_spread_mm's
 constexpr uint64_t kArmStream = 0xA53;            // ... and of SceneOptions::armless_fraction's
 constexpr uint64_t kRollStream = 0x5011;          // ... and of SceneOptions::rolled_fraction's
+constexpr uint64_t kBottleStream = 0xB0771E;      // ... and of SceneOptions::bottle_share's
 constexpr double kSubjectSpread = 0.10;      // subjects within +-10 % (as the synth's random subjects)
 constexpr int kTrainingSequenceFrames = 300;  // motion frames are drawn from 300-frame sequences
 constexpr int kHeldOutSequenceFrames = 241;   // held-out motions: other lengths, so other time samples
 constexpr double kImageSpread = 0.25;         // palm centre within +-25 % of the image size of its centre
 constexpr int kMaxSceneAttempts = 20;
-constexpr double kMinBallMm = 20.0;  // held balls: a golf ball to a large orange (radius)
+constexpr double kMinBallMm = 20.0;  // held balls: a golf ball to a large orange (radius); bottles alike
 constexpr double kMaxBallMm = 45.0;
 
 constexpr std::array<synth::Background, 3> kBackgrounds = {synth::Background::kBody, synth::Background::kTable,
@@ -93,7 +94,10 @@ Scene make_scene(uint64_t seed, uint64_t index, const SceneOptions& options) {
     s.pose = random_pose(rng, synth::HandShape::for_subject(*s.options.subject), options);
   }
   if (options.ball_fraction > 0.0 && rng.uniform() < options.ball_fraction) {
-    s.options.ball_radius_mm = rng.uniform(kMinBallMm, kMaxBallMm);
+    const double radius = rng.uniform(kMinBallMm, kMaxBallMm);
+    const bool bottle = options.bottle_share > 0.0 &&
+                        synth::Rng::stream(seed, index, kBottleStream).uniform() < options.bottle_share;
+    (bottle ? s.options.bottle_radius_mm : s.options.ball_radius_mm) = radius;
   }
   if (options.body_fraction > 0.0 && rng.uniform() < options.body_fraction &&
       s.options.view != synth::View::kHeadMounted) {

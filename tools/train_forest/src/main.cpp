@@ -231,6 +231,10 @@ int main(int argc, char** argv) {
   app.add_option("--ball-fraction", scene.ball_fraction,
                  "Share of images with a ball held against the palm (radius 20-45 mm), its pixels background")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--bottle-share", scene.bottle_share,
+                 "Of the images with a held object, the share holding a bottle (handtrack-synth --bottle: a capsule "
+                 "across the palm, radius 20-45 mm) instead of a ball")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--body-fraction", scene.body_fraction,
                  "Share of images of the body inside the working volume without the hand (a head, the rest of a "
                  "torso: what a free hand slot would be given), all background")
@@ -318,7 +322,8 @@ int main(int argc, char** argv) {
             << " --candidates " << train.candidates << " --thresholds " << train.thresholds_per_feature
             << " --min-leaf " << train.min_leaf_samples << " --motion-fraction " << scene.motion_fraction
             << " --turned-fraction " << scene.turned_fraction << " --view-fraction " << scene.view_fraction
-            << " --ball-fraction " << scene.ball_fraction << " --body-fraction " << scene.body_fraction
+            << " --ball-fraction " << scene.ball_fraction << " --bottle-share " << scene.bottle_share
+            << " --body-fraction " << scene.body_fraction
             << " --varied-fraction " << scene.varied_fraction << " --distance-spread-mm " << scene.distance_spread_mm
             << " --armless-fraction " << scene.armless_fraction << " --rolled-fraction " << scene.rolled_fraction
             << " --pose-far-mm " << scene.far_mm

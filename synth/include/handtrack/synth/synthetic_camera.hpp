@@ -98,6 +98,11 @@ struct SynthOptions {
   // > 0: a ball of this radius (mm, at most 100) held against the palm, moving with it (one-hand
   // motions); not the hand (label 0). The grasping motions close the fingers around it.
   double ball_radius_mm = 0.0;
+  // > 0: a bottle of this radius (mm, at most 100; a capsule, its axis 130 mm long between the
+  // centres of its round ends) held against the palm across its width, moving with it (one-hand
+  // motions; not with a ball); not the hand (label 0). An object the forest never saw in training:
+  // it learned only balls (docs/TRACKER.md, "A held object").
+  double bottle_radius_mm = 0.0;
   // The hand moved this far along the ray through its palm centre in every frame: < 0 nearer the
   // camera, > 0 farther (mm, within [-250, 250]; one-hand motions). The motion's own movement
   // and the scene behind the hand stay as they are.

@@ -55,6 +55,10 @@ struct SceneOptions {
   // that the tracker can drop them (DepthInputConfig::drop_background). Drawn after everything else
   // in a scene, so 0 leaves the data set of the forests trained before it unchanged.
   double ball_fraction = 0.0;
+  // Of those held objects, the share that are bottles instead of balls (synth --bottle: a capsule of
+  // the same radius across the palm). Drawn from a stream of its own, so 0 leaves the data set
+  // unchanged (docs/TRACKER.md, "A held object").
+  double bottle_share = 0.0;
   // Share of the images that show what a free hand slot is given besides the hand when the body is
   // inside the working volume (synth --background near-body, not with the head-mounted view): the
   // surface segmentation takes once the hand and its forearm are gone (a head, the rest of a
