@@ -83,7 +83,7 @@ PlanePatch desk_under(std::span<const ConeSphere> primitives, View view) {
   return make_patch(down * (far - kDeskContactMm), -down, 0.0, 0.0);
 }
 
-constexpr double kMaxBallRadiusMm = 100.0;
+constexpr double kMaxHeldRadiusMm = 100.0;  // a held ball's or bottle's
 constexpr double kMaxDepthOffsetMm = 250.0;
 // The palm's half thickness (its pieces' radii, hand_model.cpp): a held ball rests on its surface.
 constexpr double kPalmHalfThicknessMm = 13.5;
@@ -276,11 +276,10 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   if (is_two_hand_motion(options.motion) && one_hand_only != nullptr) {
     throw std::invalid_argument("motion '" + options.motion + "': " + one_hand_only + " is for one-hand motions");
   }
-  if (!(options.ball_radius_mm >= 0.0 && options.ball_radius_mm <= kMaxBallRadiusMm)) {
-    throw std::invalid_argument("ball radius must be within [0, 100] mm");
-  }
-  if (!(options.bottle_radius_mm >= 0.0 && options.bottle_radius_mm <= kMaxBallRadiusMm)) {
-    throw std::invalid_argument("bottle radius must be within [0, 100] mm");
+  for (const auto& [object, radius] : {std::pair{"ball", options.ball_radius_mm}, {"bottle", options.bottle_radius_mm}}) {
+    if (!(radius >= 0.0 && radius <= kMaxHeldRadiusMm)) {
+      throw std::invalid_argument(std::string(object) + " radius must be within [0, 100] mm");
+    }
   }
   if (options.ball_radius_mm > 0.0 && options.bottle_radius_mm > 0.0) {
     throw std::invalid_argument("one held object at a time: a ball or a bottle");

@@ -29,6 +29,17 @@ SynthOptions clean_options(const std::string& motion, Background bg = Background
   return o;
 }
 
+// The palm pixels of `plain` that `held` (the same frame with a held object) shows as the object
+// (label 0), nearer the camera than the palm was.
+size_t palm_pixels_hidden_by_object(const SynthFrame& plain, const SynthFrame& held) {
+  size_t hidden = 0;
+  for (size_t i = 0; i < plain.depth.depth_mm.size(); ++i) {
+    const bool over_palm = plain.labels.pixels[i] == handtrack::kPalm && held.labels.pixels[i] == 0;
+    hidden += over_palm && held.depth.depth_mm[i] < plain.depth.depth_mm[i] ? 1 : 0;
+  }
+  return hidden;
+}
+
 int pixel_index(const handtrack::CameraIntrinsics& cam, const Eigen::Vector2d& uv) {
   const int u = static_cast<int>(std::lround(uv.x()));
   const int v = static_cast<int>(std::lround(uv.y()));
@@ -298,12 +309,7 @@ TEST(SynthScenes, ADeskUnderTheHandAndABallInIt) {
   ball.ball_radius_mm = 35.0;
   const SynthFrame a = SyntheticCamera(plain).render(60);
   const SynthFrame b = SyntheticCamera(ball).render(60);
-  size_t covered = 0;
-  for (size_t i = 0; i < a.depth.depth_mm.size(); ++i) {
-    const bool ball_over_palm = a.labels.pixels[i] == handtrack::kPalm && b.labels.pixels[i] == 0;
-    covered += ball_over_palm && b.depth.depth_mm[i] < a.depth.depth_mm[i] ? 1 : 0;
-  }
-  EXPECT_GT(covered, 500u);
+  EXPECT_GT(palm_pixels_hidden_by_object(a, b), 500u);
   ball.ball_radius_mm = 150.0;
   EXPECT_THROW(SyntheticCamera{ball}, std::invalid_argument);
   o.motion = "two_apart";
@@ -320,12 +326,7 @@ TEST(SynthScenes, ABottleHeldAcrossThePalmReachesPastBothSidesOfTheHand) {
   const SynthFrame a = SyntheticCamera(plain).render(60);
   const SynthFrame b = SyntheticCamera(bottle).render(60);
   const int w = a.depth.camera.width;
-  size_t covered = 0;
-  for (size_t i = 0; i < a.depth.depth_mm.size(); ++i) {
-    const bool over_palm = a.labels.pixels[i] == handtrack::kPalm && b.labels.pixels[i] == 0;
-    covered += over_palm && b.depth.depth_mm[i] < a.depth.depth_mm[i] ? 1 : 0;
-  }
-  EXPECT_GT(covered, 500u);
+  EXPECT_GT(palm_pixels_hidden_by_object(a, b), 500u);
   // The row of the palm pixels' centroid: the hand's extent in it, and the bottle's nearer pixels.
   double v_sum = 0.0;
   size_t palm = 0;
