@@ -24,8 +24,9 @@ constexpr int kTrainingSequenceFrames = 300;  // motion frames are drawn from 30
 constexpr int kHeldOutSequenceFrames = 241;   // held-out motions: other lengths, so other time samples
 constexpr double kImageSpread = 0.25;         // palm centre within +-25 % of the image size of its centre
 constexpr int kMaxSceneAttempts = 20;
-constexpr double kMinBallMm = 20.0;  // held balls: a golf ball to a large orange (radius); bottles alike
-constexpr double kMaxBallMm = 45.0;
+// Radius of the held objects drawn: a golf ball to a large orange, bottles alike.
+constexpr double kMinTrainingHeldRadiusMm = 20.0;
+constexpr double kMaxTrainingHeldRadiusMm = 45.0;
 
 constexpr std::array<synth::Background, 3> kBackgrounds = {synth::Background::kBody, synth::Background::kTable,
                                                            synth::Background::kNone};
@@ -94,7 +95,7 @@ Scene make_scene(uint64_t seed, uint64_t index, const SceneOptions& options) {
     s.pose = random_pose(rng, synth::HandShape::for_subject(*s.options.subject), options);
   }
   if (options.ball_fraction > 0.0 && rng.uniform() < options.ball_fraction) {
-    const double radius = rng.uniform(kMinBallMm, kMaxBallMm);
+    const double radius = rng.uniform(kMinTrainingHeldRadiusMm, kMaxTrainingHeldRadiusMm);
     const bool bottle = options.bottle_share > 0.0 &&
                         synth::Rng::stream(seed, index, kBottleStream).uniform() < options.bottle_share;
     (bottle ? s.options.bottle_radius_mm : s.options.ball_radius_mm) = radius;

@@ -50,10 +50,11 @@ struct SceneOptions {
   // Share of the motion frames seen in another view than palm (synth/views.hpp: back, side, fingers
   // toward or away, head-mounted), drawn uniformly among them.
   double view_fraction = 0.5;
-  // Share of the images with a ball held against the palm (radius kMinBallMm..kMaxBallMm; synth
-  // --ball): its pixels that segmentation keeps with the hand are background (label 0) to learn, so
-  // that the tracker can drop them (DepthInputConfig::drop_background). Drawn after everything else
-  // in a scene, so 0 leaves the data set of the forests trained before it unchanged.
+  // Share of the images with a ball held against the palm (radius kMinTrainingHeldRadiusMm..
+  // kMaxTrainingHeldRadiusMm; synth --ball): its pixels that segmentation keeps with the hand are
+  // background (label 0) to learn, so that the tracker can drop them
+  // (DepthInputConfig::drop_background). Drawn after everything else in a scene, so 0 leaves the
+  // data set of the forests trained before it unchanged.
   double ball_fraction = 0.0;
   // Of those held objects, the share that are bottles instead of balls (synth --bottle: a capsule of
   // the same radius across the palm). Drawn from a stream of its own, so 0 leaves the data set
