@@ -668,6 +668,26 @@ TEST(PartForestTraining, DistanceSpreadMovesTheMotionImagesAndNothingElse) {
   EXPECT_GT(farther, motions / 8);
 }
 
+TEST(PartForestTraining, DistanceFartherOnlyMovesTheMotionImagesFartherOnly) {
+  // --distance-farther-only: the offset drawn from [0, spread] instead, over the whole of it.
+  forest::SceneOptions spread;
+  spread.distance_spread_mm = 100.0;
+  spread.distance_farther_only = true;
+  int near_half = 0;
+  int far_half = 0;
+  const int motions = visit_motion_scenes(
+      spread, [](const forest::Scene& s) { return s.options.depth_offset_mm; },
+      [&](double offset) {
+        EXPECT_GE(offset, 0.0);
+        EXPECT_LE(offset, 100.0);
+        near_half += offset < 50.0 ? 1 : 0;
+        far_half += offset > 50.0 ? 1 : 0;
+      });
+  EXPECT_GT(motions, 30);
+  EXPECT_GT(near_half, motions / 4);
+  EXPECT_GT(far_half, motions / 4);
+}
+
 TEST(PartForestTraining, ArmlessFractionDrawsThatShareWithoutTheArmAndNothingElse) {
   // --armless-fraction: a share of the images' hands drawn without the arm (synth --arm none), from
   // a stream of its own; everything else as without it.

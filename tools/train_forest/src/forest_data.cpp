@@ -119,7 +119,8 @@ Scene make_scene(uint64_t seed, uint64_t index, const SceneOptions& options) {
   }
   if (s.from_motion && options.distance_spread_mm > 0.0) {
     s.options.depth_offset_mm = synth::Rng::stream(seed, index, kDistanceStream)
-                                    .uniform(-options.distance_spread_mm, options.distance_spread_mm);
+                                    .uniform(options.distance_farther_only ? 0.0 : -options.distance_spread_mm,
+                                             options.distance_spread_mm);
   }
   return s;
 }

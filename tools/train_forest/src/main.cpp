@@ -247,6 +247,8 @@ int main(int argc, char** argv) {
                  "Motion images moved nearer or farther along their palm ray by up to this many mm (handtrack-synth "
                  "--depth-offset; default 0: where the motions hold the hand)")
       ->check(CLI::Range(0.0, 250.0));
+  app.add_flag("--distance-farther-only", scene.distance_farther_only,
+               "With --distance-spread-mm: the motion images moved farther only, by 0 to the spread");
   app.add_option("--rolled-fraction", scene.rolled_fraction,
                  "Share of the motion images seen through a camera rolled about its axis, by an angle uniform in "
                  "[-180, 180] deg (handtrack-synth --roll: the forearm from any image edge)")
@@ -325,6 +327,7 @@ int main(int argc, char** argv) {
             << " --ball-fraction " << scene.ball_fraction << " --bottle-share " << scene.bottle_share
             << " --body-fraction " << scene.body_fraction
             << " --varied-fraction " << scene.varied_fraction << " --distance-spread-mm " << scene.distance_spread_mm
+            << (scene.distance_farther_only ? " --distance-farther-only" : "")
             << " --armless-fraction " << scene.armless_fraction << " --rolled-fraction " << scene.rolled_fraction
             << " --pose-far-mm " << scene.far_mm
             << " --volume-far-mm " << scene.volume_far_mm << " --probes " << probes << " --seed " << train.seed;

@@ -75,6 +75,9 @@ struct SceneOptions {
   // random poses 250-far_mm. Drawn from a stream of its own, so 0 leaves the data set unchanged
   // (docs/TRACKER.md, "Hands nearer and farther").
   double distance_spread_mm = 0.0;
+  // The offset drawn from [0, spread] instead: the motion images moved farther only (the hands the
+  // labels fail are the farther ones; docs/TRACKER.md, "Hands nearer and farther").
+  bool distance_farther_only = false;
   // Share of the images whose hand is drawn without its arm, cut at the wrist (synth --arm none: a
   // renderer's hand model). Drawn from a stream of its own, so 0 leaves the data set unchanged
   // (docs/TRACKER.md, "A hand without its arm").
