@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace handtrack::synth {
@@ -75,6 +76,105 @@ double Rng::fast_normal() {
   const auto i = static_cast<size_t>(x);
   const double frac = x - static_cast<double>(i);
   return table[i] + frac * (table[i + 1] - table[i]);
+}
+
+
+std::vector<float> Rng::correlated_normals(int width, int height, double sigma_px) {
+  // White noise over the image and a margin of the kernel's reach, so that the border pixels are
+  // as smooth as the rest; blurred along rows, then columns. A separable kernel g (sum 1) leaves
+  // white noise with variance (sum g_i^2)^2, hence the scale.
+  const int reach = static_cast<int>(std::ceil(3.0 * sigma_px));
+  std::vector<double> g(static_cast<size_t>(2 * reach + 1));
+  double sum = 0.0;
+  for (int k = -reach; k <= reach; ++k) {
+    sum += g[static_cast<size_t>(k + reach)] = std::exp(-0.5 * k * k / (sigma_px * sigma_px));
+  }
+  double sum_sq = 0.0;
+  for (double& w : g) {
+    w /= sum;
+    sum_sq += w * w;
+  }
+  const int pw = width + 2 * reach;
+  const int ph = height + 2 * reach;
+  std::vector<float> white(static_cast<size_t>(pw) * static_cast<size_t>(ph));
+  for (float& x : white) x = static_cast<float>(fast_normal());
+  std::vector<float> rows(static_cast<size_t>(width) * static_cast<size_t>(ph));
+  for (int v = 0; v < ph; ++v) {
+    for (int u = 0; u < width; ++u) {
+      double acc = 0.0;
+      for (int k = 0; k <= 2 * reach; ++k) acc += g[static_cast<size_t>(k)] * white[static_cast<size_t>(v) * pw + u + k];
+      rows[static_cast<size_t>(v) * width + u] = static_cast<float>(acc);
+    }
+  }
+  std::vector<float> out(static_cast<size_t>(width) * static_cast<size_t>(height));
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      double acc = 0.0;
+      for (int k = 0; k <= 2 * reach; ++k) acc += g[static_cast<size_t>(k)] * rows[static_cast<size_t>(v + k) * width + u];
+      out[static_cast<size_t>(v) * width + u] = static_cast<float>(acc / sum_sq);
+    }
+  }
+  return out;
+}
+
+std::string_view sensor_name(Sensor sensor) {
+  return sensor == Sensor::kStructuredLight ? "structured-light" : "generic";
+}
+
+std::optional<Sensor> parse_sensor(std::string_view name) {
+  for (Sensor s : {Sensor::kGeneric, Sensor::kStructuredLight}) {
+    if (sensor_name(s) == name) return s;
+  }
+  return std::nullopt;
+}
+
+NoiseParams sensor_noise(Sensor sensor, int width) {
+  NoiseParams p;
+  if (sensor == Sensor::kStructuredLight) {
+    p.projector_x_mm = -50.0;
+    p.noise_correlation_px = 2.5 * width / 320.0;
+  }
+  return p;
+}
+
+std::vector<uint8_t> projector_lit(std::span<const float> depth_mm, int width, int height, double fx,
+                                   double projector_x_mm) {
+  // A surface this much nearer on a pixel's projector column shades it; neighbouring pixels this
+  // close in depth are one surface, which covers the projector columns between theirs.
+  constexpr float kSurfaceStepMm = 10.0f;
+  std::vector<uint8_t> lit(depth_mm.size(), 1);
+  // The projector's row as a z-buffer over its columns round(x_p), shifted by `margin` (the image's
+  // width): a surface shifted further lies outside the projector's image and is left lit.
+  const long margin = width;
+  std::vector<float> zbuf(static_cast<size_t>(width + 2 * margin));
+  const auto bin = [&](int u, float z) { return std::lround(u - fx * projector_x_mm / z) + margin; };
+  const auto inside = [&](long b) { return b >= 0 && b < static_cast<long>(zbuf.size()); };
+  const auto has_surface = [](float z) { return std::isfinite(z) && z > 0.0f; };
+  for (int v = 0; v < height; ++v) {
+    const std::span<const float> row = depth_mm.subspan(static_cast<size_t>(v) * width, static_cast<size_t>(width));
+    std::fill(zbuf.begin(), zbuf.end(), std::numeric_limits<float>::infinity());
+    for (int u = 0; u < width; ++u) {
+      const float z = row[static_cast<size_t>(u)];
+      if (!has_surface(z)) continue;
+      long lo = bin(u, z), hi = lo;
+      if (u + 1 < width && has_surface(row[static_cast<size_t>(u) + 1]) &&
+          std::abs(row[static_cast<size_t>(u) + 1] - z) < kSurfaceStepMm) {
+        const long next = bin(u + 1, row[static_cast<size_t>(u) + 1]);
+        lo = std::min(lo, next);
+        hi = std::max(hi, next);
+      }
+      for (long b = std::max(lo, 0L); b <= std::min(hi, static_cast<long>(zbuf.size()) - 1); ++b) {
+        zbuf[static_cast<size_t>(b)] = std::min(zbuf[static_cast<size_t>(b)], z);
+      }
+    }
+    for (int u = 0; u < width; ++u) {
+      const float z = row[static_cast<size_t>(u)];
+      const long b = has_surface(z) ? bin(u, z) : 0;
+      lit[static_cast<size_t>(v) * width + static_cast<size_t>(u)] =
+          has_surface(z) && (!inside(b) || z <= zbuf[static_cast<size_t>(b)] + kSurfaceStepMm);
+    }
+  }
+  return lit;
 }
 
 }  // namespace handtrack::synth

@@ -538,13 +538,20 @@ void SyntheticCamera::State::apply_noise(int frame, SynthFrame& out) const {
   const auto& labels = raycaster.labels();
   const auto& incidence = raycaster.incidence_cos();
   Rng rng = Rng::stream(options.seed, kNoiseStream, static_cast<uint64_t>(frame));
+  // Item 6 of noise.hpp. The scene is the right hand's world for a left hand (mirrored after
+  // develop()), so the projector sits on the other side in it.
+  const double projector_x = options.hand == Handedness::kLeft ? -np.projector_x_mm : np.projector_x_mm;
+  const std::vector<uint8_t> lit =
+      projector_x != 0.0 ? projector_lit(clean, w, h, options.camera.fx, projector_x) : std::vector<uint8_t>{};
+  const std::vector<float> smooth_normals =
+      np.noise_correlation_px > 0.0 ? rng.correlated_normals(w, h, np.noise_correlation_px) : std::vector<float>{};
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const size_t i = static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u);
       double z = clean[i];
       out.depth.depth_mm[i] = 0.0f;
       out.labels.pixels[i] = 0;
-      if (!std::isfinite(z)) continue;
+      if (!std::isfinite(z) || (!lit.empty() && lit[i] == 0)) continue;
       // Flying pixels: the neighbour across the largest depth jump (no surface = +inf depth, an
       // infinite jump).
       double jump = 0.0;
@@ -570,7 +577,7 @@ void SyntheticCamera::State::apply_noise(int frame, SynthFrame& out) const {
       const double grazing = np.grazing_dropout_max * std::clamp(1.0 - incidence[i] / np.grazing_cos, 0.0, 1.0);
       if (grazing > 0.0 && rng.uniform() < grazing) continue;
       // sigma(z) = k z^2, then quantisation.
-      z += np.sigma_mm(z) * rng.fast_normal();
+      z += np.sigma_mm(z) * (smooth_normals.empty() ? rng.fast_normal() : smooth_normals[i]);
       if (np.quantization_mm > 0.0 && z > 0.0) {
         // Round half up (z > 0); a cast instead of std::round keeps this inline in the pixel loop.
         z = static_cast<double>(static_cast<int64_t>(z / np.quantization_mm + 0.5)) * np.quantization_mm;

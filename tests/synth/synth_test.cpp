@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <ctime>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <vector>
@@ -283,6 +285,108 @@ TEST(SynthNoise, QuantisedAndWithinRange) {
     EXPECT_LE(z, 1500.0f);
   }
   EXPECT_GT(valid, 10000u);  // the table fills the lower part of the image
+}
+
+// noise.hpp item 6 on a scene whose shadow is known: a wall at 600 mm and, in front of it at 400
+// mm, a wide block (columns 100-139) and a narrow one (200-203). fx 225 and a projector 50 mm to
+// the camera's left shift a column by fx 50 / z: 28.1 px at the blocks, 18.75 at the wall. The
+// wall's pixel u is in shadow where round(u + 18.75) = u + 19 falls among the blocks' projector
+// columns, u + 28 for u in [a, b]: 140-148 (fx 50 (1/400 - 1/600) = 9.4 px) beside the wide block,
+// 209-212 beside the narrow one, which leaves 204-208 lit between the narrow block and its shadow.
+TEST(SynthNoise, AProjectorsShadowFallsOnTheFarSurfaceAwayFromTheProjector) {
+  constexpr int w = 320, h = 2;
+  std::vector<float> depth(w * h, 600.0f);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 100; u < 140; ++u) depth[static_cast<size_t>(v * w + u)] = 400.0f;
+    for (int u = 200; u < 204; ++u) depth[static_cast<size_t>(v * w + u)] = 400.0f;
+  }
+  depth[5] = depth[w + 5] = std::numeric_limits<float>::infinity();  // no surface: no depth, no shadow
+  const auto shaded = [&](double projector_x) {
+    const std::vector<uint8_t> lit = projector_lit(depth, w, h, 225.0, projector_x);
+    std::vector<int> columns;
+    for (int u = 0; u < w; ++u) {
+      EXPECT_EQ(lit[static_cast<size_t>(u)], lit[static_cast<size_t>(w + u)]) << "rows differ at " << u;
+      if (lit[static_cast<size_t>(u)] == 0) columns.push_back(u);
+    }
+    return columns;
+  };
+  std::vector<int> expected = {5};
+  for (int u = 140; u < 149; ++u) expected.push_back(u);
+  for (int u = 209; u < 213; ++u) expected.push_back(u);
+  EXPECT_EQ(shaded(-50.0), expected);
+  // The projector to the right: the bands to the image left, 91-99 and 191-194.
+  expected = {5};
+  for (int u = 91; u < 100; ++u) expected.push_back(u);
+  for (int u = 191; u < 195; ++u) expected.push_back(u);
+  EXPECT_EQ(shaded(50.0), expected);
+  EXPECT_EQ(shaded(0.0), std::vector<int>{5});
+}
+
+TEST(SynthNoise, CorrelatedNoiseHasUnitVarianceAndTheBlursCorrelation) {
+  // Ten fields: a blur of 2.5 px leaves about 1,000 independent values in one 320 x 240 field, too
+  // few for the mean and variance to 0.05.
+  Rng rng(3);
+  constexpr int w = 320, h = 240, fields = 10;
+  constexpr double sigma = 2.5;
+  const std::array<int, 4> lags = {1, 3, 5, 10};
+  double sum = 0.0, sum_sq = 0.0;
+  std::array<double, 4> products{};
+  for (int k = 0; k < fields; ++k) {
+    const std::vector<float> f = rng.correlated_normals(w, h, sigma);
+    ASSERT_EQ(f.size(), static_cast<size_t>(w * h));
+    for (float x : f) sum += x, sum_sq += static_cast<double>(x) * x;
+    for (size_t l = 0; l < lags.size(); ++l) {
+      double c = 0.0;
+      for (int v = 0; v < h; ++v) {
+        for (int u = 0; u + lags[l] < w; ++u) c += f[static_cast<size_t>(v * w + u)] * f[static_cast<size_t>(v * w + u + lags[l])];
+      }
+      products[l] += c / static_cast<double>(h * (w - lags[l]));
+    }
+  }
+  const double n = static_cast<double>(fields) * w * h;
+  const double mean = sum / n;
+  const double var = sum_sq / n - mean * mean;
+  EXPECT_NEAR(mean, 0.0, 0.03);
+  EXPECT_NEAR(var, 1.0, 0.05);
+  // A Gaussian blur of s px leaves white noise correlated exp(-L^2 / (4 s^2)) at L px.
+  for (size_t l = 0; l < lags.size(); ++l) {
+    EXPECT_NEAR(products[l] / fields / var, std::exp(-lags[l] * lags[l] / (4.0 * sigma * sigma)), 0.03) << "lag " << lags[l];
+  }
+}
+
+// A structured-light camera is the same camera for either hand: the projector's shadow lies to
+// the image right of the hand whether it is a right or a left one (left hands are rendered as the
+// right hand's mirror image, noise.hpp item 6 on the other side).
+TEST(SynthNoise, AStructuredLightCamerasShadowLiesOnItsOwnSideForEitherHand) {
+  for (Handedness hand : {Handedness::kRight, Handedness::kLeft}) {
+    SCOPED_TRACE(std::string(handedness_name(hand)));
+    SynthOptions o = clean_options("adbadd", Background::kBody);
+    o.hand = hand;
+    o.noise = true;
+    SyntheticCamera generic(o);
+    o.noise_params = sensor_noise(Sensor::kStructuredLight, o.camera.width);
+    SyntheticCamera structured(o);
+    const SynthFrame g = generic.render(100), s = structured.render(100);
+    // Body pixels (label 0, depth) the structured light loses, by their side of the hand's pixels
+    // on the same row: a band of zeros beside the hand's outline.
+    int right_of_hand = 0, left_of_hand = 0;
+    const int w = g.depth.width();
+    for (int v = 0; v < g.depth.height(); ++v) {
+      int first = w, last = -1;
+      for (int u = 0; u < w; ++u) {
+        if (g.labels.pixels[static_cast<size_t>(v * w + u)] != 0) first = std::min(first, u), last = std::max(last, u);
+      }
+      if (last < 0) continue;
+      for (int u = 0; u < w; ++u) {
+        const auto i = static_cast<size_t>(v * w + u);
+        if (g.labels.pixels[i] != 0 || g.depth.depth_mm[i] == 0 || s.depth.depth_mm[i] != 0) continue;
+        right_of_hand += u > last && u <= last + 15 ? 1 : 0;
+        left_of_hand += u < first && u >= first - 15 ? 1 : 0;
+      }
+    }
+    EXPECT_GT(right_of_hand, 200);
+    EXPECT_LT(left_of_hand, right_of_hand / 10);
+  }
 }
 
 TEST(SynthScenes, ADeskUnderTheHandAndABallInIt) {

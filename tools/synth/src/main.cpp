@@ -95,6 +95,8 @@ void write_subject_json(const fs::path& file, const handtrack::synth::SyntheticC
                       {"seed", o.seed},
                       {"noise", o.noise},
                       {"noise_sigma_k_per_mm", o.noise_params.sigma_k_per_mm},
+                      {"projector_x_mm", o.noise_params.projector_x_mm},
+                      {"noise_correlation_px", o.noise_params.noise_correlation_px},
                       {"background", std::string(handtrack::synth::background_name(o.background))},
                       {"ball_radius_mm", o.ball_radius_mm},
                       {"bottle_radius_mm", o.bottle_radius_mm},
@@ -253,6 +255,21 @@ int main(int argc, char** argv) {
                  "Horizontal field of view in degrees (default: the SPEC.md camera's 70.9; a Kinect's is about 58, a "
                  "RealSense D435's 87)")
       ->check(CLI::Range(20.0, 150.0));
+  std::string sensor = "generic";
+  app.add_option("--sensor", sensor,
+                 "Sensor class whose artefacts the noise imitates: generic (default: independent noise per pixel, "
+                 "flying pixels, dropouts) or structured-light (as the SR305 frames show it: a projector 50 mm to "
+                 "the camera's left whose shadow has no depth, and noise correlated over neighbouring pixels)");
+  double projector_x_mm = 0.0;
+  app.add_option("--projector-x", projector_x_mm,
+                 "With --sensor structured-light: the projector's offset along the camera's x axis in mm (default "
+                 "-50; positive: to the camera's right, its shadow to the image left of nearer surfaces)")
+      ->check(CLI::Range(-200.0, 200.0));
+  double noise_correlation_px = 0.0;
+  app.add_option("--noise-correlation", noise_correlation_px,
+                 "With --sensor structured-light: the standard deviation in pixels of the blur that correlates the "
+                 "depth noise (default 2.5 at 320 px wide, scaled with --width; 0: independent per pixel)")
+      ->check(CLI::Range(0.0, 50.0));
   app.add_flag("--preview", preview, "Also write preview/NNNNNN.png (depth gray | labels in colour)");
   app.add_flag("--no-labels", no_labels, "Do not write labels/");
   app.add_flag("--force", force, "Replace a sequence already in --out");
@@ -298,6 +315,13 @@ int main(int argc, char** argv) {
   if (!shape_proportions) return fail("--proportions must be mean or varied, got '" + proportions + "'");
   const auto shown_arm = handtrack::synth::parse_arm(arm);
   if (!shown_arm) return fail("--arm must be none, forearm or shoulder, got '" + arm + "'");
+  const auto sensor_class = handtrack::synth::parse_sensor(sensor);
+  if (!sensor_class) return fail("--sensor must be generic or structured-light, got '" + sensor + "'");
+  for (const char* option : {"--projector-x", "--noise-correlation"}) {
+    if (app.count(option) > 0 && *sensor_class != handtrack::synth::Sensor::kStructuredLight) {
+      return fail(std::string(option) + " needs --sensor structured-light");
+    }
+  }
 
   try {
     options.motion = motion;
@@ -311,6 +335,9 @@ int main(int argc, char** argv) {
     options.view = *arrangement;
     options.camera = app.count("--fov") > 0 ? handtrack::synth::camera_with_fov(width, height, fov_deg)
                                             : handtrack::synth::default_camera(width, height);
+    options.noise_params = handtrack::synth::sensor_noise(*sensor_class, width);
+    if (app.count("--projector-x") > 0) options.noise_params.projector_x_mm = projector_x_mm;
+    if (app.count("--noise-correlation") > 0) options.noise_params.noise_correlation_px = noise_correlation_px;
     if (!subject.empty()) options.subject = parse_subject(subject);
     handtrack::synth::SyntheticCamera cam(options);
 
