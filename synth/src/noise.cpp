@@ -78,7 +78,6 @@ double Rng::fast_normal() {
   return table[i] + frac * (table[i + 1] - table[i]);
 }
 
-
 std::vector<float> Rng::correlated_normals(int width, int height, double sigma_px) {
   // White noise over the image and a margin of the kernel's reach, so that the border pixels are
   // as smooth as the rest; blurred along rows, then columns. A separable kernel g (sum 1) leaves
@@ -94,6 +93,12 @@ std::vector<float> Rng::correlated_normals(int width, int height, double sigma_p
     w /= sum;
     sum_sq += w * w;
   }
+  // g convolved with `src` at `src[0], src[step], ..., src[2 reach step]`.
+  const auto blur = [&g, reach](const float* src, size_t step) {
+    double acc = 0.0;
+    for (int k = 0; k <= 2 * reach; ++k) acc += g[static_cast<size_t>(k)] * src[static_cast<size_t>(k) * step];
+    return acc;
+  };
   const int pw = width + 2 * reach;
   const int ph = height + 2 * reach;
   std::vector<float> white(static_cast<size_t>(pw) * static_cast<size_t>(ph));
@@ -101,17 +106,14 @@ std::vector<float> Rng::correlated_normals(int width, int height, double sigma_p
   std::vector<float> rows(static_cast<size_t>(width) * static_cast<size_t>(ph));
   for (int v = 0; v < ph; ++v) {
     for (int u = 0; u < width; ++u) {
-      double acc = 0.0;
-      for (int k = 0; k <= 2 * reach; ++k) acc += g[static_cast<size_t>(k)] * white[static_cast<size_t>(v) * pw + u + k];
-      rows[static_cast<size_t>(v) * width + u] = static_cast<float>(acc);
+      rows[static_cast<size_t>(v) * width + u] = static_cast<float>(blur(&white[static_cast<size_t>(v) * pw + u], 1));
     }
   }
   std::vector<float> out(static_cast<size_t>(width) * static_cast<size_t>(height));
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
-      double acc = 0.0;
-      for (int k = 0; k <= 2 * reach; ++k) acc += g[static_cast<size_t>(k)] * rows[static_cast<size_t>(v + k) * width + u];
-      out[static_cast<size_t>(v) * width + u] = static_cast<float>(acc / sum_sq);
+      out[static_cast<size_t>(v) * width + u] =
+          static_cast<float>(blur(&rows[static_cast<size_t>(v) * width + u], static_cast<size_t>(width)) / sum_sq);
     }
   }
   return out;
