@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
+#include <vector>
 
 namespace handtrack::synth {
 namespace {
@@ -25,6 +27,31 @@ FingerShape finger(const Vector3d& base, const Vector3d& direction, const Vector
 
 ConeSphere palm_piece(const Vector3d& a, const Vector3d& b, double ra, double rb) {
   return ConeSphere{a, b, ra, rb, kPalm};
+}
+
+// The palm's solids bent by the transverse arch (palm_arch_offset_mm). A piece across the palm
+// (more x than y between its ends: the knuckle row, the cross pieces, the wrist) is a straight
+// capsule that would cut the chord of the arch, so it is split into kArchSegments pieces whose
+// ends lie on the arch (radii linear along it); a piece along the palm (a metacarpal) has its two
+// ends moved.
+std::vector<ConeSphere> arched_palm(const std::vector<ConeSphere>& palm, const SubjectScale& subject) {
+  constexpr int kArchSegments = 4;
+  const auto arched = [&](Vector3d p) {
+    p.z() += palm_arch_offset_mm(p.x(), subject);
+    return p;
+  };
+  std::vector<ConeSphere> out;
+  for (const ConeSphere& c : palm) {
+    const Vector3d d = c.b - c.a;
+    const int segments = std::abs(d.x()) > std::abs(d.y()) ? kArchSegments : 1;
+    for (int k = 0; k < segments; ++k) {
+      const double t0 = static_cast<double>(k) / segments;
+      const double t1 = static_cast<double>(k + 1) / segments;
+      out.push_back(ConeSphere{arched(c.a + t0 * d), arched(c.a + t1 * d), c.radius_a + t0 * (c.radius_b - c.radius_a),
+                               c.radius_a + t1 * (c.radius_b - c.radius_a), c.label});
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -145,7 +172,17 @@ HandShape HandShape::for_subject(const SubjectScale& subject) {
     c.radius_b *= subject.width * subject.palm_thickness;
   }
   s.palm_centre_mm = scale_point(s.palm_centre_mm);
+  if (subject.palm_arch_mm != 0.0) {  // else the flat palm, byte for byte as before the arch
+    s.palm = arched_palm(s.palm, subject);
+    for (auto& f : s.fingers) f.base_mm.z() += palm_arch_offset_mm(f.base_mm.x(), subject);
+  }
   return s;
+}
+
+double palm_arch_offset_mm(double x_mm, const SubjectScale& subject) {
+  constexpr double kArchHalfWidthMm = 27.0;
+  const double u = x_mm / (kArchHalfWidthMm * subject.width);
+  return subject.palm_arch_mm * u * u;
 }
 
 Joints hand_frame_joints(const HandShape& shape, const HandPose& pose) {

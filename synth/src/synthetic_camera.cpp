@@ -85,6 +85,7 @@ PlanePatch desk_under(std::span<const ConeSphere> primitives, View view) {
 
 constexpr double kMaxHeldRadiusMm = 100.0;  // a held ball's or bottle's
 constexpr double kMaxDepthOffsetMm = 250.0;
+constexpr double kMaxPalmArchMm = 20.0;  // twice what a cupped hand shows at its knuckles
 // The palm's half thickness (its pieces' radii, hand_model.cpp): a held ball rests on its surface.
 constexpr double kPalmHalfThicknessMm = 13.5;
 
@@ -322,6 +323,10 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
       subjects[k].palm_thickness = rng.uniform(1.0 - kGirthSpread, 1.0 + kGirthSpread);
     }
   }
+  if (!(options.palm_arch_mm >= 0.0 && options.palm_arch_mm <= kMaxPalmArchMm)) {
+    throw std::invalid_argument("palm arch must be within [0, 20] mm");
+  }
+  for (auto& subject : subjects) subject.palm_arch_mm = options.palm_arch_mm;
   options.subject = subjects[0];  // hand 0's, as options() reports it
   // The arrangement holds the forearm (views.hpp view_shape): a two-hand scene's for both hands.
   const View arrangement = seen_in(options.motion, options.view);

@@ -178,6 +178,57 @@ TEST(SynthCamera, VariedProportionsGiveEachFingerItsOwnLengthAndKeepTheSize) {
   EXPECT_GT(index_lengths.back() - index_lengths.front(), 0.06) << "the index's length hardly varies with the seed";
 }
 
+// --palm-arch: the index and little fingers' knuckles move toward the palm's side by the arch at
+// their x, the middle finger's hardly; in the palm view the camera sees the palm's sides nearer
+// and its middle where it was, and the truth (joints) carries the arched knuckles.
+TEST(SynthCamera, AnArchedPalmBringsItsSidesTowardThePalmAndKeepsItsMiddle) {
+  constexpr double kArchMm = 10.0;
+  SynthOptions o = clean_options("adbadd");
+  SyntheticCamera flat(o);
+  o.palm_arch_mm = kArchMm;
+  SyntheticCamera arched(o);
+  const double w = flat.subject().width;
+  EXPECT_EQ(arched.subject().palm_arch_mm, kArchMm);
+  const auto base_shift = [&](int finger) {
+    const auto f = static_cast<size_t>(finger);
+    return arched.shape().fingers[f].base_mm - flat.shape().fingers[f].base_mm;
+  };
+  const auto expected = [&](int finger) {
+    const double u = flat.shape().fingers[static_cast<size_t>(finger)].base_mm.x() / (27.0 * w);
+    return kArchMm * u * u;
+  };
+  for (int finger : {handtrack::kIndex, handtrack::kMiddle, handtrack::kLittle}) {
+    SCOPED_TRACE("finger " + std::to_string(finger));
+    EXPECT_NEAR(base_shift(finger).z(), expected(finger), 1e-9);
+    EXPECT_NEAR(base_shift(finger).head<2>().norm(), 0.0, 1e-12);
+  }
+  EXPECT_GT(base_shift(handtrack::kLittle).z(), 11.0);
+  EXPECT_LT(base_shift(handtrack::kMiddle).z(), 0.5);
+
+  // Frame 0: the open hand, palm toward the camera. The depth at the index and little knuckles'
+  // pixels comes nearer by about their shift (the palm's surface there moved with them); at the
+  // palm's middle it stays within a millimetre.
+  const SynthFrame f_flat = flat.render(0);
+  const SynthFrame f_arched = arched.render(0);
+  const auto depth_at = [&](const SynthFrame& f, const Eigen::Vector3d& p) {
+    const int i = pixel_index(flat.camera(), flat.camera().project(p));
+    EXPECT_GE(i, 0);
+    return i < 0 ? 0.0 : static_cast<double>(f.depth.depth_mm[static_cast<size_t>(i)]);
+  };
+  for (int finger : {handtrack::kIndex, handtrack::kLittle}) {
+    const Eigen::Vector3d knuckle = f_flat.joints[static_cast<size_t>(handtrack::joint_index(finger, 0))];
+    const double nearer = depth_at(f_flat, knuckle) - depth_at(f_arched, knuckle);
+    EXPECT_GT(nearer, 0.5 * expected(finger)) << "finger " << finger;
+    EXPECT_LT(nearer, 1.5 * expected(finger)) << "finger " << finger;
+    EXPECT_GT((f_arched.joints[static_cast<size_t>(handtrack::joint_index(finger, 0))] - knuckle).norm(),
+              0.99 * expected(finger));
+  }
+  const Eigen::Vector3d middle = (f_flat.joints[0] + f_flat.joints[static_cast<size_t>(
+                                                        handtrack::joint_index(handtrack::kMiddle, 0))]) /
+                                 2.0;
+  EXPECT_NEAR(depth_at(f_arched, middle), depth_at(f_flat, middle), 1.0);
+}
+
 TEST(SynthCamera, SameSeedSameFramesDifferentSeedDifferentNoise) {
   SynthOptions o = clean_options("random");
   o.noise = true;
@@ -693,6 +744,11 @@ TEST(SynthCamera, RejectsBadOptions) {
   o.subject = SubjectScale{};
   o.subject->palm_thickness = std::nan("");
   EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);
+  o = SynthOptions{};
+  for (double arch : {-1.0, 21.0, std::nan("")}) {
+    o.palm_arch_mm = arch;
+    EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument) << "palm arch " << arch;
+  }
   o = SynthOptions{};
   o.roll_deg = 181.0;
   EXPECT_THROW(SyntheticCamera{o}, std::invalid_argument);

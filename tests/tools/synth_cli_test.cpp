@@ -246,7 +246,7 @@ TEST_F(SynthCli, AHandWithoutItsArmIsCutAtTheWrist) {
 
 // --proportions varied: subject.json says so and gives each hand's proportions, which its bone
 // lengths follow; the size stays the seed's. Anything but mean or varied is one clear error.
-TEST_F(SynthCli, VariedProportionsAreDrawnFromTheSeedAndWrittenDown) {
+TEST_F(SynthCli, VariedProportionsAndAPalmArchAreWrittenDown) {
   const fs::path mean = dir_ / "mean", varied = dir_ / "varied";
   const std::string args = "--motion adbadd --frames 2 --seed 4 --no-noise --background none ";
   ASSERT_EQ(run(args + "--out '" + mean.string() + "'").exit_code, 0);
@@ -262,6 +262,16 @@ TEST_F(SynthCli, VariedProportionsAreDrawnFromTheSeedAndWrittenDown) {
   EXPECT_NEAR(v.at("fingers").at("ring").at("bone_lengths_mm")[0].get<double>(),
               m.at("fingers").at("ring").at("bone_lengths_mm")[0].get<double>() * ring, 1e-9);
   expect_one_line_error(args + "--proportions thin --out '" + (dir_ / "x").string() + "'", "--proportions");
+
+  // An arched palm is written down with the knuckles it moved; the default is flat.
+  const fs::path arched = dir_ / "arched";
+  const RunResult a = run(args + "--palm-arch 8 --out '" + arched.string() + "'");
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  const auto j = nlohmann::json::parse(slurp(arched / "subject.json"));
+  EXPECT_EQ(m.at("palm_arch_mm"), 0.0);
+  EXPECT_EQ(j.at("palm_arch_mm"), 8.0);
+  EXPECT_GT(j.at("fingers").at("little").at("base_mm")[2].get<double>(), 8.0);
+  expect_one_line_error(args + "--palm-arch 30 --out '" + (dir_ / "x").string() + "'", "--palm-arch");
 }
 
 // A two-hand motion writes both hands (docs/SEQUENCES.md): hand.json names them, each CSV row holds

@@ -83,6 +83,7 @@ void add_scales(nlohmann::json& j, const handtrack::synth::SubjectScale& s) {
   j["finger_length_scales"] = s.finger_length;
   j["finger_girth_scale"] = s.finger_girth;
   j["palm_thickness_scale"] = s.palm_thickness;
+  j["palm_arch_mm"] = s.palm_arch_mm;
 }
 
 // The subject: one hand's scales and fingers at the top level; for a two-hand motion "hands", one
@@ -216,6 +217,10 @@ int main(int argc, char** argv) {
   app.add_option("--proportions", proportions,
                  "mean (default: the mean adult's, scaled by the subject's size) or varied (each hand's finger "
                  "lengths, finger girth and palm thickness drawn from the seed as well)");
+  app.add_option("--palm-arch", options.palm_arch_mm,
+                 "Arch the palm about its long axis: its sides (the index and little fingers' knuckles) this many mm "
+                 "toward the palm's side, as a real hand's transverse arch (default 0: flat)")
+      ->check(CLI::Range(0.0, 20.0));
   app.add_flag("--noise,!--no-noise", options.noise, "Sensor noise model on (default) or off");
   app.add_option("--background", background,
                  "Background: body (default; head-mounted view and two_reach: table), table, desk (the hand rests on it), "

@@ -66,12 +66,16 @@ struct JointLimits {
 // Sec. 6): each finger's bones by `finger_length[f]` (thumb..little), the fingers' radii by
 // `finger_girth` and the palm's solids' radii (its thickness) by `palm_thickness`. All 1: the mean
 // adult's proportions, which every subject had before (SynthOptions::proportions).
+// `palm_arch_mm`: the transverse metacarpal arch, the palm bent about its long axis so that its
+// sides lie toward the palm's side of the hand; 0 (the default) is the flat palm every render had
+// before (SynthOptions::palm_arch_mm).
 struct SubjectScale {
   double length = 1.0;
   double width = 1.0;
   std::array<double, kNumFingers> finger_length{1.0, 1.0, 1.0, 1.0, 1.0};
   double finger_girth = 1.0;
   double palm_thickness = 1.0;
+  double palm_arch_mm = 0.0;
 };
 
 struct FingerShape {
@@ -115,9 +119,18 @@ struct HandShape {
   // The mean adult right hand (scale 1.0) of the module brief.
   static HandShape mean_adult();
   // mean_adult() scaled: lengths and y by subject.length, x, z and radii by subject.width, then
-  // each finger's bones, the fingers' radii and the palm's radii by the subject's proportions.
+  // each finger's bones, the fingers' radii and the palm's radii by the subject's proportions,
+  // then the palm arched by subject.palm_arch_mm (palm_arch_offset_mm).
   static HandShape for_subject(const SubjectScale& subject);
 };
+
+// The transverse arch of the palm at hand-frame x (mm, the hand already scaled): how far toward the
+// palm's side (+z) the palm's solids and the fingers' bases there are moved, arch (x / x_a)^2 with
+// x_a = 27 mm x width, the mean metacarpal head's distance from the middle finger's. The index and
+// little fingers' knuckles (x = 24 and -30 mm) sit 0.8 and 1.2 x arch toward the palm, the middle
+// finger's (x = 4) 0.02 x arch: the ends of a hand's transverse arch, which real palms have and
+// the flat default does not.
+double palm_arch_offset_mm(double x_mm, const SubjectScale& subject);
 
 // The 21 joints (SPEC.md order: wrist, then thumb..little MCP/CMC, PIP, DIP, TIP) in the hand frame.
 Joints hand_frame_joints(const HandShape& shape, const HandPose& pose);

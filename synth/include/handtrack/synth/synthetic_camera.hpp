@@ -89,6 +89,9 @@ struct SynthOptions {
   std::optional<SubjectScale> subject;
   // kVaried: each hand's proportions drawn from the seed, replacing the subject's.
   Proportions proportions = Proportions::kMean;
+  // > 0: every hand's palm arched, its sides this far (mm, at most 20) toward the palm's side at
+  // the mean metacarpal head's distance from the middle (SubjectScale::palm_arch_mm); 0: flat.
+  double palm_arch_mm = 0.0;
   bool noise = true;
   Background background = Background::kBody;
   CameraIntrinsics camera = default_camera();
