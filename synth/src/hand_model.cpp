@@ -29,16 +29,24 @@ ConeSphere palm_piece(const Vector3d& a, const Vector3d& b, double ra, double rb
   return ConeSphere{a, b, ra, rb, kPalm};
 }
 
-// The palm's solids bent by the transverse arch (palm_arch_offset_mm). A piece across the palm
-// (more x than y between its ends: the knuckle row, the cross pieces, the wrist) is a straight
-// capsule that would cut the chord of the arch, so it is split into kArchSegments pieces whose
-// ends lie on the arch (radii linear along it); a piece along the palm (a metacarpal) has its two
-// ends moved.
+// The palm's solids under the transverse arch (palm_arch_offset_mm). A piece across the palm (more
+// x than y between its ends: the knuckle row, the cross pieces, the wrist) is a straight capsule
+// that would cut the chord of the arch, so it is split into kArchSegments pieces whose ends follow
+// it (radii linear along it); a piece along the palm (a metacarpal) has its two ends moved. With
+// the whole palm bent (PalmArch::kBent) each end moves by the arch's offset o toward the palm's
+// side; with the back alone (PalmArch::kBack) its centre moves o / 2 and its radius shrinks by
+// o / 2, so the palm's front (centre + radius) stays where it was and its back moves by o.
 std::vector<ConeSphere> arched_palm(const std::vector<ConeSphere>& palm, const SubjectScale& subject) {
   constexpr int kArchSegments = 4;
-  const auto arched = [&](Vector3d p) {
-    p.z() += palm_arch_offset_mm(p.x(), subject);
-    return p;
+  const double share = subject.palm_arch == PalmArch::kBack ? 0.5 : 1.0;
+  struct End {
+    Vector3d centre;
+    double radius;
+  };
+  const auto arched = [&](Vector3d p, double radius) {
+    const double o = palm_arch_offset_mm(p.x(), subject);
+    p.z() += share * o;
+    return End{p, radius - (1.0 - share) * o};
   };
   std::vector<ConeSphere> out;
   for (const ConeSphere& c : palm) {
@@ -47,8 +55,9 @@ std::vector<ConeSphere> arched_palm(const std::vector<ConeSphere>& palm, const S
     for (int k = 0; k < segments; ++k) {
       const double t0 = static_cast<double>(k) / segments;
       const double t1 = static_cast<double>(k + 1) / segments;
-      out.push_back(ConeSphere{arched(c.a + t0 * d), arched(c.a + t1 * d), c.radius_a + t0 * (c.radius_b - c.radius_a),
-                               c.radius_a + t1 * (c.radius_b - c.radius_a), c.label});
+      const End a = arched(c.a + t0 * d, c.radius_a + t0 * (c.radius_b - c.radius_a));
+      const End b = arched(c.a + t1 * d, c.radius_a + t1 * (c.radius_b - c.radius_a));
+      out.push_back(ConeSphere{a.centre, b.centre, a.radius, b.radius, c.label});
     }
   }
   return out;
@@ -174,7 +183,9 @@ HandShape HandShape::for_subject(const SubjectScale& subject) {
   s.palm_centre_mm = scale_point(s.palm_centre_mm);
   if (subject.palm_arch_mm != 0.0) {  // else the flat palm, byte for byte as before the arch
     s.palm = arched_palm(s.palm, subject);
-    for (auto& f : s.fingers) f.base_mm.z() += palm_arch_offset_mm(f.base_mm.x(), subject);
+    if (subject.palm_arch == PalmArch::kBent) {  // the knuckles ride on the bent palm
+      for (auto& f : s.fingers) f.base_mm.z() += palm_arch_offset_mm(f.base_mm.x(), subject);
+    }
   }
   return s;
 }

@@ -326,7 +326,10 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
   if (!(options.palm_arch_mm >= 0.0 && options.palm_arch_mm <= kMaxPalmArchMm)) {
     throw std::invalid_argument("palm arch must be within [0, 20] mm");
   }
-  for (auto& subject : subjects) subject.palm_arch_mm = options.palm_arch_mm;
+  for (auto& subject : subjects) {
+    subject.palm_arch_mm = options.palm_arch_mm;
+    subject.palm_arch = options.palm_arch;
+  }
   options.subject = subjects[0];  // hand 0's, as options() reports it
   // The arrangement holds the forearm (views.hpp view_shape): a two-hand scene's for both hands.
   const View arrangement = seen_in(options.motion, options.view);

@@ -227,6 +227,35 @@ TEST(SynthCamera, AnArchedPalmBringsItsSidesTowardThePalmAndKeepsItsMiddle) {
                                                         handtrack::joint_index(handtrack::kMiddle, 0))]) /
                                  2.0;
   EXPECT_NEAR(depth_at(f_arched, middle), depth_at(f_flat, middle), 1.0);
+
+  // --palm-arch-shape back: the front stays flat (the palm view's depth at the knuckles within 1 mm,
+  // the fingers' bases where they were) and the back recedes at its sides: seen from behind, the
+  // palm's little-finger side, three quarters of the way from the wrist to that knuckle, is about
+  // the arch at its x farther.
+  o.palm_arch = PalmArch::kBack;
+  SyntheticCamera back_only(o);
+  EXPECT_EQ(back_only.shape().fingers[handtrack::kLittle].base_mm, flat.shape().fingers[handtrack::kLittle].base_mm);
+  const SynthFrame f_back_only = back_only.render(0);
+  for (int finger : {handtrack::kIndex, handtrack::kLittle}) {
+    const Eigen::Vector3d knuckle = f_flat.joints[static_cast<size_t>(handtrack::joint_index(finger, 0))];
+    EXPECT_NEAR(depth_at(f_back_only, knuckle), depth_at(f_flat, knuckle), 1.0) << "finger " << finger;
+  }
+  o.view = View::kBack;
+  o.palm_arch_mm = 0.0;
+  SyntheticCamera flat_back(o);
+  o.palm_arch_mm = kArchMm;
+  SyntheticCamera arched_back(o);
+  const SynthFrame b_flat = flat_back.render(0);
+  const SynthFrame b_arched = arched_back.render(0);
+  const auto little_mcp = static_cast<size_t>(handtrack::joint_index(handtrack::kLittle, 0));
+  const Eigen::Vector3d side = 0.25 * b_flat.joints[0] + 0.75 * b_flat.joints[little_mcp];
+  const Joints in_hand = hand_frame_joints(flat_back.shape(), flat_back.pose(0));
+  const double side_x = 0.25 * in_hand[0].x() + 0.75 * in_hand[little_mcp].x();
+  const double side_arch = kArchMm * (side_x / (27.0 * w)) * (side_x / (27.0 * w));
+  const double farther = depth_at(b_arched, side) - depth_at(b_flat, side);
+  EXPECT_GT(side_arch, 4.0);
+  EXPECT_GT(farther, 0.5 * side_arch);
+  EXPECT_LT(farther, 1.5 * side_arch);
 }
 
 TEST(SynthCamera, SameSeedSameFramesDifferentSeedDifferentNoise) {

@@ -272,6 +272,15 @@ TEST_F(SynthCli, VariedProportionsAndAPalmArchAreWrittenDown) {
   EXPECT_EQ(j.at("palm_arch_mm"), 8.0);
   EXPECT_GT(j.at("fingers").at("little").at("base_mm")[2].get<double>(), 8.0);
   expect_one_line_error(args + "--palm-arch 30 --out '" + (dir_ / "x").string() + "'", "--palm-arch");
+  EXPECT_EQ(j.at("palm_arch_shape"), "bent");
+  const fs::path back = dir_ / "back";
+  const RunResult b = run(args + "--palm-arch 8 --palm-arch-shape back --out '" + back.string() + "'");
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  const auto jb = nlohmann::json::parse(slurp(back / "subject.json"));
+  EXPECT_EQ(jb.at("palm_arch_shape"), "back");
+  EXPECT_EQ(jb.at("fingers").at("little").at("base_mm"), m.at("fingers").at("little").at("base_mm"));
+  expect_one_line_error(args + "--palm-arch 8 --palm-arch-shape cupped --out '" + (dir_ / "x").string() + "'",
+                        "--palm-arch-shape");
 }
 
 // A two-hand motion writes both hands (docs/SEQUENCES.md): hand.json names them, each CSV row holds

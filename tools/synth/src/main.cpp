@@ -84,6 +84,7 @@ void add_scales(nlohmann::json& j, const handtrack::synth::SubjectScale& s) {
   j["finger_girth_scale"] = s.finger_girth;
   j["palm_thickness_scale"] = s.palm_thickness;
   j["palm_arch_mm"] = s.palm_arch_mm;
+  j["palm_arch_shape"] = s.palm_arch == handtrack::synth::PalmArch::kBack ? "back" : "bent";
 }
 
 // The subject: one hand's scales and fingers at the top level; for a two-hand motion "hands", one
@@ -221,6 +222,12 @@ int main(int argc, char** argv) {
                  "Arch the palm about its long axis: its sides (the index and little fingers' knuckles) this many mm "
                  "toward the palm's side, as a real hand's transverse arch (default 0: flat)")
       ->check(CLI::Range(0.0, 20.0));
+  std::string palm_arch_shape = "bent";
+  app.add_option("--palm-arch-shape", palm_arch_shape,
+                 "What --palm-arch bends: bent (default: the whole palm and the knuckles on it) or back (the back "
+                 "of the hand alone; the palm's front stays flat, as a real palm's does)")
+      ->check(CLI::IsMember({"bent", "back"}))
+      ->needs("--palm-arch");
   app.add_flag("--noise,!--no-noise", options.noise, "Sensor noise model on (default) or off");
   app.add_option("--background", background,
                  "Background: body (default; head-mounted view and two_reach: table), table, desk (the hand rests on it), "
@@ -336,6 +343,7 @@ int main(int argc, char** argv) {
     options.bottle_radius_mm = bottle_radius_mm;
     options.hand = *handedness;
     options.proportions = *shape_proportions;
+    options.palm_arch = palm_arch_shape == "back" ? handtrack::synth::PalmArch::kBack : handtrack::synth::PalmArch::kBent;
     options.arm = *shown_arm;
     options.view = *arrangement;
     options.camera = app.count("--fov") > 0 ? handtrack::synth::camera_with_fov(width, height, fov_deg)

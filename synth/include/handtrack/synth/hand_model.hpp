@@ -66,9 +66,12 @@ struct JointLimits {
 // Sec. 6): each finger's bones by `finger_length[f]` (thumb..little), the fingers' radii by
 // `finger_girth` and the palm's solids' radii (its thickness) by `palm_thickness`. All 1: the mean
 // adult's proportions, which every subject had before (SynthOptions::proportions).
-// `palm_arch_mm`: the transverse metacarpal arch, the palm bent about its long axis so that its
-// sides lie toward the palm's side of the hand; 0 (the default) is the flat palm every render had
-// before (SynthOptions::palm_arch_mm).
+// `palm_arch_mm`: the transverse metacarpal arch, its sides toward the palm's side of the hand;
+// 0 (the default) is the flat palm every render had before (SynthOptions::palm_arch_mm).
+// `palm_arch`: what bends, the whole palm (kBent: both faces and the fingers' bases) or its back
+// alone (kBack: the front stays flat, the palm thinner toward its sides, as a real palm's soft
+// front fills the hollow its bones make).
+enum class PalmArch { kBent, kBack };
 struct SubjectScale {
   double length = 1.0;
   double width = 1.0;
@@ -76,6 +79,7 @@ struct SubjectScale {
   double finger_girth = 1.0;
   double palm_thickness = 1.0;
   double palm_arch_mm = 0.0;
+  PalmArch palm_arch = PalmArch::kBent;
 };
 
 struct FingerShape {
@@ -125,7 +129,8 @@ struct HandShape {
 };
 
 // The transverse arch of the palm at hand-frame x (mm, the hand already scaled): how far toward the
-// palm's side (+z) the palm's solids and the fingers' bases there are moved, arch (x / x_a)^2 with
+// palm's side (+z) the palm's back (and with PalmArch::kBent its front and the fingers' bases)
+// there is moved, arch (x / x_a)^2 with
 // x_a = 27 mm x width, the mean metacarpal head's distance from the middle finger's. The index and
 // little fingers' knuckles (x = 24 and -30 mm) sit 0.8 and 1.2 x arch toward the palm, the middle
 // finger's (x = 4) 0.02 x arch: the ends of a hand's transverse arch, which real palms have and

@@ -92,6 +92,8 @@ struct SynthOptions {
   // > 0: every hand's palm arched, its sides this far (mm, at most 20) toward the palm's side at
   // the mean metacarpal head's distance from the middle (SubjectScale::palm_arch_mm); 0: flat.
   double palm_arch_mm = 0.0;
+  // What the arch bends: the whole palm (the default) or its back alone (SubjectScale::palm_arch).
+  PalmArch palm_arch = PalmArch::kBent;
   bool noise = true;
   Background background = Background::kBody;
   CameraIntrinsics camera = default_camera();
