@@ -150,6 +150,12 @@ std::optional<Proportions> parse_proportions(std::string_view name) {
   return by_name(name, {Proportions::kMean, Proportions::kVaried}, proportions_name);
 }
 
+std::string_view palm_arch_name(PalmArch arch) { return arch == PalmArch::kBack ? "back" : "bent"; }
+
+std::optional<PalmArch> parse_palm_arch(std::string_view name) {
+  return by_name(name, {PalmArch::kBent, PalmArch::kBack}, palm_arch_name);
+}
+
 std::string_view arm_name(Arm arm) {
   switch (arm) {
     case Arm::kNone:

@@ -193,10 +193,12 @@ TEST(SynthCamera, AnArchedPalmBringsItsSidesTowardThePalmAndKeepsItsMiddle) {
     const auto f = static_cast<size_t>(finger);
     return arched.shape().fingers[f].base_mm - flat.shape().fingers[f].base_mm;
   };
-  const auto expected = [&](int finger) {
-    const double u = flat.shape().fingers[static_cast<size_t>(finger)].base_mm.x() / (27.0 * w);
+  // The arch at hand-frame x, worked out here rather than by palm_arch_offset_mm, which it checks.
+  const auto arch_at = [&](double x) {
+    const double u = x / (27.0 * w);
     return kArchMm * u * u;
   };
+  const auto expected = [&](int finger) { return arch_at(flat.shape().fingers[static_cast<size_t>(finger)].base_mm.x()); };
   for (int finger : {handtrack::kIndex, handtrack::kMiddle, handtrack::kLittle}) {
     SCOPED_TRACE("finger " + std::to_string(finger));
     EXPECT_NEAR(base_shift(finger).z(), expected(finger), 1e-9);
@@ -251,7 +253,7 @@ TEST(SynthCamera, AnArchedPalmBringsItsSidesTowardThePalmAndKeepsItsMiddle) {
   const Eigen::Vector3d side = 0.25 * b_flat.joints[0] + 0.75 * b_flat.joints[little_mcp];
   const Joints in_hand = hand_frame_joints(flat_back.shape(), flat_back.pose(0));
   const double side_x = 0.25 * in_hand[0].x() + 0.75 * in_hand[little_mcp].x();
-  const double side_arch = kArchMm * (side_x / (27.0 * w)) * (side_x / (27.0 * w));
+  const double side_arch = arch_at(side_x);
   const double farther = depth_at(b_arched, side) - depth_at(b_flat, side);
   EXPECT_GT(side_arch, 4.0);
   EXPECT_GT(farther, 0.5 * side_arch);

@@ -84,7 +84,7 @@ void add_scales(nlohmann::json& j, const handtrack::synth::SubjectScale& s) {
   j["finger_girth_scale"] = s.finger_girth;
   j["palm_thickness_scale"] = s.palm_thickness;
   j["palm_arch_mm"] = s.palm_arch_mm;
-  j["palm_arch_shape"] = s.palm_arch == handtrack::synth::PalmArch::kBack ? "back" : "bent";
+  j["palm_arch_shape"] = std::string(handtrack::synth::palm_arch_name(s.palm_arch));
 }
 
 // The subject: one hand's scales and fingers at the top level; for a two-hand motion "hands", one
@@ -226,7 +226,6 @@ int main(int argc, char** argv) {
   app.add_option("--palm-arch-shape", palm_arch_shape,
                  "What --palm-arch bends: bent (default: the whole palm and the knuckles on it) or back (the back "
                  "of the hand alone; the palm's front stays flat, as a real palm's does)")
-      ->check(CLI::IsMember({"bent", "back"}))
       ->needs("--palm-arch");
   app.add_flag("--noise,!--no-noise", options.noise, "Sensor noise model on (default) or off");
   app.add_option("--background", background,
@@ -325,6 +324,8 @@ int main(int argc, char** argv) {
   if (!handedness) return fail("--hand must be right or left, got '" + hand + "'");
   const auto shape_proportions = handtrack::synth::parse_proportions(proportions);
   if (!shape_proportions) return fail("--proportions must be mean or varied, got '" + proportions + "'");
+  const auto arch_shape = handtrack::synth::parse_palm_arch(palm_arch_shape);
+  if (!arch_shape) return fail("--palm-arch-shape must be bent or back, got '" + palm_arch_shape + "'");
   const auto shown_arm = handtrack::synth::parse_arm(arm);
   if (!shown_arm) return fail("--arm must be none, forearm or shoulder, got '" + arm + "'");
   const auto sensor_class = handtrack::synth::parse_sensor(sensor);
@@ -343,7 +344,7 @@ int main(int argc, char** argv) {
     options.bottle_radius_mm = bottle_radius_mm;
     options.hand = *handedness;
     options.proportions = *shape_proportions;
-    options.palm_arch = palm_arch_shape == "back" ? handtrack::synth::PalmArch::kBack : handtrack::synth::PalmArch::kBent;
+    options.palm_arch = *arch_shape;
     options.arm = *shown_arm;
     options.view = *arrangement;
     options.camera = app.count("--fov") > 0 ? handtrack::synth::camera_with_fov(width, height, fov_deg)

@@ -62,6 +62,10 @@ enum class Proportions { kMean, kVaried };
 std::string_view proportions_name(Proportions proportions);  // "mean", "varied"
 std::optional<Proportions> parse_proportions(std::string_view name);
 
+// What --palm-arch bends (SubjectScale::palm_arch).
+std::string_view palm_arch_name(PalmArch arch);  // "bent", "back"
+std::optional<PalmArch> parse_palm_arch(std::string_view name);
+
 // How much of the arm the scene shows: the hand alone, cut at the wrist, as renderers of a hand
 // model without an arm show it; the forearm to a rounded elbow (the
 // default); or the arm on past the elbow to the shoulder (views.hpp, with_upper_arm).
