@@ -1,6 +1,7 @@
 #include "handtrack/core/tracker.hpp"
 
 #include "background_search.hpp"
+#include "handtrack/core/palm_hollow.hpp"
 #include "self_calibration.hpp"
 
 #include <algorithm>
@@ -171,6 +172,14 @@ std::optional<Handedness> expected_side_toward_camera(const TrackerOutput& as_ri
 // viewing axis.
 bool squarely_facing(const TrackerOutput& fit) { return std::abs(fit.palm_normal.z()) > std::numbers::sqrt2 / 2.0; }
 
+// Two fits that face the camera squarely, one with its palm and the other with its back: mirror
+// images through the hand's plane.
+bool mirror_twins(const TrackerOutput& as_right, const TrackerOutput& as_left) {
+  const bool both_fitted = as_right.state != TrackingState::kNoHand && as_left.state != TrackingState::kNoHand;
+  return both_fitted && squarely_facing(as_right) && squarely_facing(as_left) &&
+         palm_toward_camera(as_right, as_left).has_value();
+}
+
 // One frame's handedness evidence: how much better the left hand's fit explains the hand than the
 // right hand's (Tracker::weigh).
 //
@@ -182,16 +191,36 @@ bool squarely_facing(const TrackerOutput& fit) { return std::abs(fit.palm_normal
 // part_forest.md: 90 against 82 % of pixels), and the palm-toward fit is labelled on the image
 // where the hand looks like a palm view (the mirrored image for a left hand). On the flat hands of
 // adbadd seen from the back the labels chose the palm-toward mirror image in most frames, while the
-// depth alone (the fingers flex toward the palm, the thumb sits in front of it) chose the true hand.
-// So for that pair the evidence is the confidence difference (docs/TRACKER.md, "Handedness by
-// evidence over frames").
-double handedness_difference(const TrackerOutput& as_right, const TrackerOutput& as_left) {
-  const bool both_fitted = as_right.state != TrackingState::kNoHand && as_left.state != TrackingState::kNoHand;
-  if (both_fitted && squarely_facing(as_right) && squarely_facing(as_left) &&
-      palm_toward_camera(as_right, as_left)) {
-    return as_left.confidence - as_right.confidence;
+// depth alone (the fingers flex toward the palm, the thumb sits in front of it) chose the true hand,
+// there: our renders' hand is the model's own, and on a hand whose back is convex the two fits
+// explained it alike (0.91 and 0.90; docs/TRACKER.md, "A hollow palm and a convex back"). So for
+// that pair the evidence is the confidence difference (docs/TRACKER.md, "Handedness by
+// evidence over frames"), and the palm's hollow where the depth shows one (`hollow_mm`,
+// palm_hollow.hpp: > 0 a palm faces the camera, < 0 the back): up to kHollowEvidence toward the fit
+// that shows the camera that side, in full from kFullHollowMm.
+double handedness_difference(const TrackerOutput& as_right, const TrackerOutput& as_left,
+                             std::optional<double> hollow_mm) {
+  if (!mirror_twins(as_right, as_left)) return as_left.score() - as_right.score();
+  double difference = as_left.confidence - as_right.confidence;
+  if (hollow_mm) {
+    const double palm_shown = std::clamp(*hollow_mm / kFullHollowMm, -1.0, 1.0);
+    const double toward_left = palm_toward_camera(as_right, as_left) == Handedness::kLeft ? 1.0 : -1.0;
+    difference += kHollowEvidence * palm_shown * toward_left;
   }
-  return as_left.score() - as_right.score();
+  return difference;
+}
+
+// palm_hollow_mm of the pair's palm (the two share its plane), from the input of either hand that
+// has one: a left hand's is the mirrored image, where its fit is mirrored back. Only for mirror
+// twins, the one pair it tells apart.
+std::optional<double> twins_hollow_mm(const TrackerOutput& as_right, const TrackerOutput& as_left,
+                                      const DepthInput* right, const DepthInput* left) {
+  if (!mirror_twins(as_right, as_left)) return std::nullopt;
+  if (right != nullptr) return palm_hollow_mm(*right, as_right);
+  if (left == nullptr) return std::nullopt;
+  TrackerOutput in_mirrored_image = as_left;
+  mirror_output(in_mirrored_image);
+  return palm_hollow_mm(*left, in_mirrored_image);
 }
 }  // namespace
 
@@ -205,7 +234,7 @@ bool Tracker::trial_restarts() const {
 
 bool Tracker::trial_skips(Handedness hand) const { return side(hand).lost() && !trial_restarts(); }
 
-void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left) {
+void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left, std::optional<double> hollow_mm) {
   // A hand seen on one frame can be either: a fist, a hand edge-on, or a flat hand whose palm or
   // back faces the camera (a right hand's palm and a left hand's back are mirror images through the
   // hand's plane, the same to the sphere model). As it moves, the fingers flex toward the palm of
@@ -229,7 +258,7 @@ void Tracker::weigh(const TrackerOutput& as_right, const TrackerOutput& as_left)
   trial_fitted_[0] = trial_fitted_[0] || as_right.state != TrackingState::kNoHand;
   trial_fitted_[1] = trial_fitted_[1] || as_left.state != TrackingState::kNoHand;
   if (trial_fitted_[0] && trial_fitted_[1]) {
-    const double difference = handedness_difference(as_right, as_left);
+    const double difference = handedness_difference(as_right, as_left, hollow_mm);
     evidence_ = weighed_before ? evidence_ + config().handedness_evidence_rate * (difference - evidence_) : difference;
   } else if (frames >= config().handedness_trial_frames && trial_fitted_[0] != trial_fitted_[1]) {
     evidence_ = trial_fitted_[1] ? config().handedness_margin : -config().handedness_margin;
@@ -303,7 +332,7 @@ TrackerOutput Tracker::optimise(const TrackerInputs& inputs) {
     };
     const TrackerOutput as_right = trial_fit(Handedness::kRight, right);
     const TrackerOutput as_left = trial_fit(Handedness::kLeft, left);
-    weigh(as_right, as_left);
+    weigh(as_right, as_left, twins_hollow_mm(as_right, as_left, right, left));
     out = current_ == Handedness::kLeft ? as_left : as_right;
     // A hand that found no fit is not reported over one that did.
     const TrackerOutput& other = current_ == Handedness::kLeft ? as_right : as_left;

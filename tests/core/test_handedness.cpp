@@ -359,9 +359,13 @@ TEST(HandednessRetrial, AHandTakenForTheWrongHandOnAFistIsTriedAgain) {
 // its right-hand fit and the left hand's mirror image with the palm toward the camera explain the
 // depth alike, and its first trial's evidence is a tie. What the depth leaves open, the camera's
 // arrangement decides (TrackerConfig::arrangement, Tracker::weigh): a camera facing the user
-// expects the palm, and reports this hand as a left hand throughout; a head-mounted camera expects
-// the back, and reports the right hand. (Subject 3 was this scene until the surface fronts,
-// 2026-11-29, which tell its side in 19 % of the frames; of subjects 1-9 only 7 is still a tie.)
+// expects the palm, and reports this hand as a left hand (throughout until 2026-12-02); a
+// head-mounted camera expects the back, and reports the right hand. (Subject 3 was this scene until
+// the surface fronts, 2026-11-29, which tell its side in 19 % of the frames; of subjects 1-9 only 7
+// is still a tie.) Since the palm's hollow is weighed (palm_hollow.hpp), the renderer's flat hand
+// reads 0.1-1.5 mm convex from behind, a little evidence for its back: the first frame's tie still
+// goes to the palm, and the trial, whose evidence never leaves the margin, passes the tie on frame
+// 249 and turns the last 52 of the 300 frames to the right hand (17 %; the bound: 25 %).
 TEST(HandednessTie, AFlatHandShowsTheSideItsCamerasArrangementExpects) {
   const synth::SynthOptions options = benchmark_sequence("adbadd", synth::View::kBack, 7);
   const auto share_right = [&](CameraArrangement arrangement) {
@@ -374,8 +378,29 @@ TEST(HandednessTie, AFlatHandShowsTheSideItsCamerasArrangementExpects) {
     return share_as_shown(run);
   };
   EXPECT_GE(share_right(CameraArrangement::kHeadMounted), 0.95);
-  EXPECT_LE(share_right(CameraArrangement::kFacing), 0.05)
+  EXPECT_LE(share_right(CameraArrangement::kFacing), 0.25)
       << "the depth now tells this hand's side: this scene no longer tests the arrangement";
+}
+
+// A flat hand whose back is convex, as a real hand's is (handtrack-synth --palm-arch 8
+// --palm-arch-shape back: the back of the hand arched across the knuckles by 8 mm, its palm flat),
+// seen from the back (adbadd, subject 2): the right hand's fit and the left hand's palm-toward mirror
+// image explain it alike (confidence 0.91 against 0.90), and before the palm's hollow was weighed the
+// first frame's tie went to the palm toward a desk camera: the wrong hand throughout, the right hand
+// and its mirror image, the left hand, alike (0 % right, 2026-12-02). The depth's convexity across
+// the palm (palm_hollow.hpp) tells the back: each is the hand it is in nearly every frame.
+TEST(HandednessHollow, AConvexBackSeenFromBehindIsTheHandItIs) {
+  for (const synth::Handedness hand : {synth::Handedness::kRight, synth::Handedness::kLeft}) {
+    synth::SynthOptions options = benchmark_sequence("adbadd", synth::View::kBack, 2);
+    options.hand = hand;
+    options.palm_arch_mm = 8.0;
+    options.palm_arch = synth::PalmArch::kBack;
+    const testing::OneHandRun run = track_late_fusion(options, TrackerConfig{});
+    std::printf("%s hand: %d of %d frames reported as the hand shown, %.1f mm\n",
+                hand == synth::Handedness::kRight ? "right" : "left", run.reported_as_shown, run.posed,
+                run.mean_error_mm());
+    EXPECT_GE(share_as_shown(run), 0.95) << (hand == synth::Handedness::kRight ? "right" : "left") << " hand";
+  }
 }
 
 // A fist seen from behind (fingercount in the head-mounted view, subject 5, as in

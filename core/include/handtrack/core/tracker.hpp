@@ -437,9 +437,9 @@ class Tracker {
   // A hand the trial does not fit on this frame (lost, and no (re)start due): request() does not
   // ask for its input.
   [[nodiscard]] bool trial_skips(Handedness hand) const;
-  // One frame of a handedness trial: the evidence from both hands' fits, the hand it favours
-  // (current_), and the trial's end.
-  void weigh(const TrackerOutput& as_right, const TrackerOutput& as_left);
+  // One frame of a handedness trial: the evidence from both hands' fits (and, for mirror twins, the
+  // palm's hollow: palm_hollow.hpp), the hand it favours (current_), and the trial's end.
+  void weigh(const TrackerOutput& as_right, const TrackerOutput& as_left, std::optional<double> hollow_mm);
   TrackerOutput fit(Handedness hand, const DepthInput& input);
   void identify(TrackerOutput& out);  // sets out.hand_id
   // Offers the frame to the hand's self-calibration (TrackerConfig::self_calibrate) and takes the
