@@ -3,7 +3,7 @@
 // behind the hand) and eight poses per frame near and off the true pose (energy_cases.hpp).
 //
 //   preprocessing   DepthInputBuilder::build without and with the part forest, the forest alone,
-//                   E_free's map and E_unseen's weights of a frame
+//                   E_free's map and E_unseen's weights of a frame, the palm's hollow of a fit
 //   E_sim           energy + gradient per factor, the optimised term and the plain reference
 //   E               PoseEnergy::evaluate (posing the model, every term, the chain rule)
 //   E_hand          the two-hand collision term alone, and E with another hand touching or apart
@@ -17,6 +17,7 @@
 #include "handtrack/core/energy.hpp"
 #include "handtrack/core/free_space.hpp"
 #include "handtrack/core/optimizer.hpp"
+#include "handtrack/core/palm_hollow.hpp"
 #include "handtrack/core/part_forest.hpp"
 
 #include <benchmark/benchmark.h>
@@ -141,6 +142,27 @@ void BM_UnseenFingers(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_UnseenFingers)->Unit(benchmark::kMicrosecond);
+
+// The palm's hollow (palm_hollow.hpp) of one frame's fit, here the rendered pose: read on a
+// handedness trial's frames where the two hands' fits are mirror twins, never while one hand
+// tracks.
+void BM_PalmHollow(benchmark::State& state) {
+  std::vector<TrackerOutput> fits;
+  for (const auto& c : cases()) {
+    const PosedHand posed(model(), c.truth);
+    TrackerOutput fit;
+    fit.joints = posed.joints();
+    fit.palm_centre = posed.to_camera(model().palm_centre());
+    fit.palm_normal = posed.camera_R_hand() * Eigen::Vector3d::UnitZ();
+    fits.push_back(fit);
+  }
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(palm_hollow_mm(cases()[i].input, fits[i]));
+    i = (i + 1) % cases().size();
+  }
+}
+BENCHMARK(BM_PalmHollow)->Unit(benchmark::kMicrosecond);
 
 // E_sim and its gradient for one posed model: the optimised term (label: 0 depth, 1 label factor;
 // capped: with the shipped coverage cap, two passes, or eq. 6's one).
