@@ -29,8 +29,9 @@ namespace handtrack {
 
 // How a frame's handedness evidence (Tracker::weigh) counts c for a pair of mirror twins: c /
 // kFullHollowMm, within [-1, 1], times kHollowEvidence toward the fit that shows the camera the side
-// c says. 5 mm: a real palm's hollow and a back's arch (+0.7 to +10 mm measured), above the 1-2 mm
-// a flat render reads; 0.15: handedness_margin, so that a clear hollow or arch alone decides.
+// c says. 5 mm: above the 1-2 mm a flat render reads, about the middle of the real palms' +0.7 to
+// +10 mm, below a convex back's 6-8; 0.15: handedness_margin, so that a clear hollow or arch alone
+// decides. Neither was tuned (docs/TRACKER.md, "A hollow palm and a convex back").
 inline constexpr double kFullHollowMm = 5.0;
 inline constexpr double kHollowEvidence = 0.15;
 
