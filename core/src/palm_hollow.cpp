@@ -25,6 +25,9 @@ constexpr int kMinPalmHollowPixels = 50;
 // (fingers folded over it) or seen edge-on.
 constexpr double kMinPalmHollowNear = 0.8;
 
+// A region corner nearer than this (or behind the camera) is not projected.
+constexpr double kMinCornerDepthMm = 1.0;
+
 bool fit_finite(const TrackerOutput& fit) {
   return std::all_of(fit.joints.begin(), fit.joints.end(), [](const Eigen::Vector3d& j) { return j.allFinite(); }) &&
          fit.palm_normal.allFinite() && fit.palm_centre.allFinite();
@@ -33,17 +36,18 @@ bool fit_finite(const TrackerOutput& fit) {
 }  // namespace
 
 std::optional<double> palm_hollow_mm(const DepthInput& input, const TrackerOutput& fit) {
-  const Eigen::Vector3d& wrist = fit.joints[0];
-  const Eigen::Vector3d middle = fit.joints[joint_index(2, 0)];
-  const Eigen::Vector3d index = fit.joints[joint_index(1, 0)];
-  const Eigen::Vector3d little = fit.joints[joint_index(4, 0)];
+  if (!fit_finite(fit) || input.hand_mask.empty()) return std::nullopt;
+  const Eigen::Vector3d& wrist = fit.joints[kWristJoint];
+  const Eigen::Vector3d& middle = fit.joints[joint_index(kMiddle, 0)];
+  const Eigen::Vector3d& index = fit.joints[joint_index(kIndex, 0)];
+  const Eigen::Vector3d& little = fit.joints[joint_index(kLittle, 0)];
   Eigen::Vector3d toward_camera = fit.palm_normal.normalized();
   if (toward_camera.dot(fit.palm_centre) > 0.0) toward_camera = -toward_camera;
   const double length = (middle - wrist).norm();
   const Eigen::Vector3d along = (middle - wrist) / length;
   const Eigen::Vector3d across = toward_camera.cross(along).normalized();
   const double half_width = 0.5 * std::abs((index - little).dot(across));
-  if (!(length > 0.0 && half_width > 0.0) || !fit_finite(fit) || input.hand_mask.empty()) return std::nullopt;
+  if (!(length > 0.0 && half_width > 0.0)) return std::nullopt;
   const Eigen::Vector3d centre = wrist + 0.5 * length * along;
 
   // The pixels to look at: the box of the region's corners, projected (clamped to the image before
@@ -55,7 +59,9 @@ std::optional<double> palm_hollow_mm(const DepthInput& input, const TrackerOutpu
   double v_max = -1.0;
   for (const double a : {kRegionFromWrist, kRegionToKnuckles}) {
     for (const double x : {-kRegionAcross, kRegionAcross}) {
-      const Eigen::Vector2d p = cam.project(wrist + a * length * along + x * half_width * across);
+      const Eigen::Vector3d corner = wrist + a * length * along + x * half_width * across;
+      if (corner.z() < kMinCornerDepthMm) return std::nullopt;  // not projectable: no fit of a hand in view
+      const Eigen::Vector2d p = cam.project(corner);
       u_min = std::min(u_min, p.x());
       v_min = std::min(v_min, p.y());
       u_max = std::max(u_max, p.x());

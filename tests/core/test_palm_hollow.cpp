@@ -22,11 +22,11 @@ constexpr double kHalfLengthMm = 45.0;  // wrist and middle knuckle from the pal
 TrackerOutput facing_fit(bool palm_toward_camera) {
   TrackerOutput fit;
   fit.state = TrackingState::kTracking;
-  fit.joints[0] = {0.0, kHalfLengthMm, kBonesMm};
-  fit.joints[joint_index(1, 0)] = {kHalfWidthMm, -kHalfLengthMm, kBonesMm};
-  fit.joints[joint_index(2, 0)] = {0.0, -kHalfLengthMm, kBonesMm};
-  fit.joints[joint_index(3, 0)] = {-kHalfWidthMm / 3.0, -kHalfLengthMm, kBonesMm};
-  fit.joints[joint_index(4, 0)] = {-kHalfWidthMm, -kHalfLengthMm, kBonesMm};
+  fit.joints[kWristJoint] = {0.0, kHalfLengthMm, kBonesMm};
+  fit.joints[joint_index(kIndex, 0)] = {kHalfWidthMm, -kHalfLengthMm, kBonesMm};
+  fit.joints[joint_index(kMiddle, 0)] = {0.0, -kHalfLengthMm, kBonesMm};
+  fit.joints[joint_index(kRing, 0)] = {-kHalfWidthMm / 3.0, -kHalfLengthMm, kBonesMm};
+  fit.joints[joint_index(kLittle, 0)] = {-kHalfWidthMm, -kHalfLengthMm, kBonesMm};
   fit.palm_centre = {0.0, 0.0, kBonesMm};
   fit.palm_normal = {0.0, 0.0, palm_toward_camera ? -1.0 : 1.0};
   return fit;
@@ -76,7 +76,7 @@ TEST(PalmHollow, APalmItCannotSeeTellsNothing) {
   nothing.hand_mask.assign(nothing.hand_mask.size(), 0);
   EXPECT_FALSE(palm_hollow_mm(nothing, fit)) << "no hand pixels";
   TrackerOutput broken = fit;
-  broken.joints[0].x() = std::numeric_limits<double>::quiet_NaN();
+  broken.joints[kWristJoint].x() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(palm_hollow_mm(hand_surface(6.0), broken)) << "a fit that is not finite";
   TrackerOutput edge_on = fit;
   edge_on.palm_normal = {1.0, 0.0, 0.0};  // the knuckles' line along the palm normal: no width across
