@@ -52,6 +52,23 @@ with open(out) as f:
     seeded = json.load(f)
 if seeded["late_fusion_2p_10it"].get("seed") != 3:
     failures.append(f"--seed 3 measured seed {seeded['late_fusion_2p_10it'].get('seed')!r}")
+# --runs N: every configuration measured N times; each figure is the median of the runs, each
+# run's fps listed (one run by default).
+if table["late_fusion_2p_10it"].get("fps_runs") != [table["late_fusion_2p_10it"]["fps"]]:
+    failures.append(f"one run: fps_runs {table['late_fusion_2p_10it'].get('fps_runs')!r}")
+subprocess.run([exe, "--frames", "10", "--runs", "3", "--only", "late_fusion_2p_10it", "--only", "depth_only_1p_10it",
+                "--json", out], check=True, stdout=subprocess.DEVNULL)
+with open(out) as f:
+    repeated = json.load(f)
+for name, entry in sorted(repeated.items()):
+    fps_runs = entry.get("fps_runs", [])
+    if entry.get("runs") != 3 or len(fps_runs) != 3 or not all(math.isfinite(v) and v > 0 for v in fps_runs):
+        failures.append(f"--runs 3, {name}: runs {entry.get('runs')!r}, fps_runs {fps_runs!r}")
+    elif entry["fps"] != sorted(fps_runs)[1]:
+        failures.append(f"--runs 3, {name}: fps {entry['fps']!r} is not the median of {fps_runs!r}")
+bad_runs = subprocess.run([exe, "--runs", "0"], capture_output=True, text=True)
+if bad_runs.returncode == 0 or len(bad_runs.stderr.strip().splitlines()) != 1 or "--runs" not in bad_runs.stderr:
+    failures.append(f"--runs 0: exit {bad_runs.returncode}, stderr {bad_runs.stderr!r}")
 bad = subprocess.run([exe, "--only", "no_such_configuration"], capture_output=True, text=True)
 if bad.returncode == 0 or len(bad.stderr.strip().splitlines()) != 1 or "no_such_configuration" not in bad.stderr:
     failures.append(f"--only no_such_configuration: exit {bad.returncode}, stderr {bad.stderr!r}")

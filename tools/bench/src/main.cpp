@@ -4,7 +4,10 @@
 // SPEC.md "Benchmark output". Besides the paper's three: one hand with room for two (the daemon's
 // default, max_hands 2), and two hands (issue 14) with the second hand preprocessed and optimised on
 // a side thread (the daemon's way) and all on the same thread; hand_overlap says how much of the
-// two hands' optimisation ran at once.
+// two hands' optimisation ran at once. --runs N measures every configuration N times in rounds
+// (each round all of them once, in order), so that a shared host's swings, 20 % from one minute
+// to the next here (docs/BENCHMARKS.md), fall on every configuration alike; each figure is then
+// the median of its N runs, and each run's fps is listed beside it.
 #include "handtrack/core/part_forest.hpp"
 #include "handtrack/core/hands_tracker.hpp"
 #include "handtrack/common/side_thread.hpp"
@@ -16,6 +19,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -65,6 +69,26 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// One run of one configuration over the frames.
+struct Measurement {
+  double fps = 0.0;
+  double preprocess_ms = 0.0;  // medians over the frames
+  double optimize_ms = 0.0;
+  double p50_ms = 0.0;  // latency percentiles over the frames
+  double p99_ms = 0.0;
+  double hands_per_frame = 0.0;
+  double hand_overlap = 0.0;
+};
+
+// The median over runs of one figure of theirs (of an even count, the mean of the middle two).
+double median_of(const std::vector<Measurement>& runs, double Measurement::*figure) {
+  std::vector<double> v;
+  for (const Measurement& m : runs) v.push_back(m.*figure);
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n == 0 ? 0.0 : n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -85,6 +109,11 @@ int main(int argc, char** argv) {
                  "subject of the synthetic scenes (hand size, noise; default 7): the search frames a scene draws "
                  "move the fps, so compare a change over several");
   app.add_option("--only", only, "measure only these configurations (by name; default: all)");
+  int runs = 1;
+  app.add_option("--runs", runs,
+                 "measure every configuration this many times, in rounds, and report each figure's median over "
+                 "the runs and each run's fps (a shared host swings from minute to minute)")
+      ->check(CLI::Range(1, 100));
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
 
   try {
@@ -120,13 +149,9 @@ int main(int argc, char** argv) {
     };
     const std::vector<DepthImage> one_hand = frames_of(false, motion);
     const std::vector<DepthImage> two_hands = frames_of(true, two_hand_motion);
-    nlohmann::json out = nlohmann::json::object();
-    tools::Progress progress(kProgram);
-    std::printf("%-48s %8s %14s %12s %16s %8s\n", "configuration", "fps", "preprocess_ms", "optimize_ms",
-                "latency p50/p99", "overlap");
-    for (size_t c = 0; c < configs.size(); ++c) {
-      const auto& bc = configs[c];
-      if (!measured(bc)) continue;
+    // One run of a configuration: the shipped tracker (handedness auto) over the frames, its two
+    // steps timed apart.
+    const auto run_once = [&](const BenchConfig& bc, const std::function<void(double)>& done_share) {
       TrackerConfig tc;
       tc.mode = bc.mode;
       tc.particles = bc.particles;
@@ -134,7 +159,6 @@ int main(int argc, char** argv) {
       tc.max_hands = bc.max_hands;
       tc.check_iterations_per_frame = bc.check_iterations_per_frame;
       tc.background_checks = bc.background_checks;
-      // The shipped tracker (handedness auto), its two steps timed apart.
       HandsInputs inputs(input_config(tc));
       HandsTracker tracker(tc);
       std::optional<SideThread> side;
@@ -166,16 +190,55 @@ int main(int argc, char** argv) {
         latency_ms.push_back(pre_ms.back() + opt_ms.back());
         hands += result.count;
         for (int k = 0; k < result.count; ++k) hand_ms += result.optimize_ms[static_cast<size_t>(k)];
-        progress.update(bc.name, (static_cast<double>(c) + static_cast<double>(i + 1) / frames) / configs.size());
+        done_share(static_cast<double>(i + 1) / frames);
       }
-      const double fps = frames / (ms_since(start) / 1000.0);
-      const double pre = percentile(pre_ms, 0.5);
-      const double opt = percentile(opt_ms, 0.5);
-      const double p50 = percentile(latency_ms, 0.5);
-      const double p99 = percentile(latency_ms, 0.99);
+      Measurement m;
+      m.fps = frames / (ms_since(start) / 1000.0);
+      m.preprocess_ms = percentile(pre_ms, 0.5);
+      m.optimize_ms = percentile(opt_ms, 0.5);
+      m.p50_ms = percentile(latency_ms, 0.5);
+      m.p99_ms = percentile(latency_ms, 0.99);
+      m.hands_per_frame = hands / frames;
       // How much of the hands' own optimisation ran at once: 1 = one after the other, 2 = two
       // hands entirely side by side.
-      const double overlap = opt_total_ms > 0.0 ? hand_ms / opt_total_ms : 0.0;
+      m.hand_overlap = opt_total_ms > 0.0 ? hand_ms / opt_total_ms : 0.0;
+      return m;
+    };
+
+    std::vector<const BenchConfig*> chosen;
+    for (const BenchConfig& bc : configs) {
+      if (measured(bc)) chosen.push_back(&bc);
+    }
+    std::vector<std::vector<Measurement>> runs_of(chosen.size());
+    tools::Progress progress(kProgram);
+    const double total = static_cast<double>(runs) * static_cast<double>(chosen.size());
+    for (int r = 0; r < runs; ++r) {
+      for (size_t c = 0; c < chosen.size(); ++c) {
+        const double before = static_cast<double>(r) * static_cast<double>(chosen.size()) + static_cast<double>(c);
+        runs_of[c].push_back(
+            run_once(*chosen[c], [&](double share) { progress.update(chosen[c]->name, (before + share) / total); }));
+      }
+    }
+    progress.done();
+
+    nlohmann::json out = nlohmann::json::object();
+    std::printf("%-48s %8s %14s %12s %16s %8s%s\n", "configuration", "fps", "preprocess_ms", "optimize_ms",
+                "latency p50/p99", "overlap", runs > 1 ? "  fps of each run" : "");
+    for (size_t c = 0; c < chosen.size(); ++c) {
+      const BenchConfig& bc = *chosen[c];
+      const std::vector<Measurement>& m = runs_of[c];
+      const double fps = median_of(m, &Measurement::fps);
+      const double pre = median_of(m, &Measurement::preprocess_ms);
+      const double opt = median_of(m, &Measurement::optimize_ms);
+      const double p50 = median_of(m, &Measurement::p50_ms);
+      const double p99 = median_of(m, &Measurement::p99_ms);
+      const double overlap = median_of(m, &Measurement::hand_overlap);
+      std::vector<double> fps_runs;
+      std::string fps_list;
+      for (const Measurement& run : m) {
+        fps_runs.push_back(run.fps);
+        fps_list += " " + std::to_string(static_cast<int>(std::lround(run.fps)));
+      }
       out[bc.name] = {{"fps", fps},
                       {"preprocess_ms", pre},
                       {"optimize_ms", opt},
@@ -183,15 +246,17 @@ int main(int argc, char** argv) {
                       {"particles", bc.particles},
                       {"iterations", bc.iterations},
                       {"max_hands", bc.max_hands},
-                      {"hands_per_frame", hands / frames},
+                      {"hands_per_frame", median_of(m, &Measurement::hands_per_frame)},
                       {"hand_overlap", overlap},
                       {"width", camera.width},
                       {"height", camera.height},
                       {"frames", frames},
-                      {"seed", seed}};
-      std::printf("%-48s %8.1f %14.2f %12.2f %9.2f/%.2f %8.2f\n", bc.name.c_str(), fps, pre, opt, p50, p99, overlap);
+                      {"seed", seed},
+                      {"runs", runs},
+                      {"fps_runs", fps_runs}};
+      std::printf("%-48s %8.1f %14.2f %12.2f %9.2f/%.2f %8.2f %s\n", bc.name.c_str(), fps, pre, opt, p50, p99, overlap,
+                  runs > 1 ? fps_list.c_str() : "");
     }
-    progress.done();
     if (!json_file.empty()) {
       std::ofstream f(json_file);
       if (!f) throw std::runtime_error(json_file + ": cannot write");
