@@ -254,8 +254,8 @@ int main(int argc, char** argv) {
                       {"seed", seed},
                       {"runs", runs},
                       {"fps_runs", fps_runs}};
-      std::printf("%-48s %8.1f %14.2f %12.2f %9.2f/%.2f %8.2f %s\n", bc.name.c_str(), fps, pre, opt, p50, p99, overlap,
-                  runs > 1 ? fps_list.c_str() : "");
+      std::printf("%-48s %8.1f %14.2f %12.2f %9.2f/%.2f %8.2f%s\n", bc.name.c_str(), fps, pre, opt, p50, p99, overlap,
+                  runs > 1 ? (" " + fps_list).c_str() : "");
     }
     if (!json_file.empty()) {
       std::ofstream f(json_file);
