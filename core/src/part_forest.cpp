@@ -10,6 +10,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string_view>
+#include <type_traits>
 
 namespace handtrack {
 namespace {
@@ -385,49 +386,69 @@ PartForest PartForest::from_bytes(std::span<const uint8_t> bytes, const std::str
 
 uint64_t PartForest::classify_batch(const Crop& crop, const Site* sites, int count, uint8_t* out) const {
   const float* depth = crop.depth_mm;
-  const float background = info_.background_mm;
-  // d_I(p): the crop holds the hand's depth and the background constant everywhere else, so one
-  // bounds check (a conditional move, no branch: whether a probe lands on the hand is
-  // unpredictable) makes a probe.
+  const size_t stride = static_cast<size_t>(crop.width) + 2;
+  // d_I(p): the crop holds the hand's depth, the background constant everywhere else and in a
+  // one-pixel border around it, so a probe clamped to the border reads the background wherever it
+  // leaves the box: no branch (whether a probe lands on the hand is unpredictable).
   const auto probe = [&](int px, int py) -> float {
-    const bool inside = static_cast<unsigned>(px) < static_cast<unsigned>(crop.width) &&
-                        static_cast<unsigned>(py) < static_cast<unsigned>(crop.height);
-    const size_t i = inside ? static_cast<size_t>(py) * static_cast<size_t>(crop.width) + static_cast<size_t>(px) : 0;
-    const float d = depth[i];
-    return inside ? d : background;
+    const auto cx = static_cast<size_t>(std::clamp(px, -1, crop.width) + 1);
+    const auto cy = static_cast<size_t>(std::clamp(py, -1, crop.height) + 1);
+    return depth[cy * stride + cx];
   };
   const double sx = crop.focal_ratio_x;
   const double sy = crop.focal_ratio_y;
   std::array<ProbeSteps, kBatch> steps{};
   for (int p = 0; p < count; ++p) {
-    const float d = depth[static_cast<size_t>(sites[p].y - crop.y0) * static_cast<size_t>(crop.width) +
-                          static_cast<size_t>(sites[p].x - crop.x0)];
+    const float d = probe(sites[p].x - crop.x0, sites[p].y - crop.y0);
     steps[static_cast<size_t>(p)] = probe_steps(sx, sy, d, crop.turn);
   }
-  std::array<std::array<uint32_t, kPartForestClasses>, kBatch> sum{};
-  for (const PartForestTree& tree : trees_) {
+  // One tree's descent of the batch: at[p] ends on pixel p's leaf. The pixels descend in lockstep:
+  // their node -> probe -> node chains are independent, so the CPU overlaps their memory and
+  // multiply latencies (one chain alone is latency bound). Without a turn, or with a half turn, the
+  // steps' cross terms xy and yx are 0 (probe_steps): `unturned` drops their multiplies, the same
+  // sums (16 % of the descent on 2026-12-03's host).
+  const auto descend = [&](const PartForestTree& tree, std::array<uint32_t, kBatch>& at, auto unturned) {
     const PartForestNode* nodes = tree.nodes.data();
-    // The pixels descend in lockstep: their node -> probe -> node chains are independent, so the
-    // CPU overlaps their memory and multiply latencies (one chain alone is latency bound).
-    std::array<uint32_t, kBatch> at{};
+    const auto coordinate = [](int c, int16_t a, int16_t b, int32_t ka, int32_t kb) {
+      if constexpr (decltype(unturned)::value) return probe_coordinate(c, a, 0, ka, 0);
+      return probe_coordinate(c, a, b, ka, kb);
+    };
     for (bool active = true; active;) {
       active = false;
       for (int p = 0; p < count; ++p) {
         const auto q = static_cast<size_t>(p);
         const PartForestNode& n = nodes[at[q]];
-        if (n.is_leaf()) continue;
+        if (n.is_leaf()) {
+          // The leaf is read after the descent: fetch it now (a cache miss, like the deep nodes; a
+          // leaf's 26 bytes may straddle two cache lines). Later levels find it cached.
+          const auto* leaf = reinterpret_cast<const char*>(tree.leaves.data() + n.leaf_index());
+          __builtin_prefetch(leaf);
+          __builtin_prefetch(leaf + sizeof(PartForestLeaf) - 1);
+          continue;
+        }
         active = true;
         // Crop coordinates: x + round(offset k) shifts with the crop.
         const int x = sites[p].x - crop.x0;
         const int y = sites[p].y - crop.y0;
         const ProbeSteps& k = steps[q];
-        const float a = probe(probe_coordinate(x, n.u[0], n.u[1], k.xx, k.xy), probe_coordinate(y, n.u[0], n.u[1], k.yx, k.yy));
-        const float b = probe(probe_coordinate(x, n.v[0], n.v[1], k.xx, k.xy), probe_coordinate(y, n.v[0], n.v[1], k.yx, k.yy));
+        const float a = probe(coordinate(x, n.u[0], n.u[1], k.xx, k.xy), coordinate(y, n.u[1], n.u[0], k.yy, k.yx));
+        const float b = probe(coordinate(x, n.v[0], n.v[1], k.xx, k.xy), coordinate(y, n.v[1], n.v[0], k.yy, k.yx));
         at[q] = n.child + ((a - b) < n.threshold ? 0U : 1U);
         // The next node of this pixel is needed only after the other pixels' steps: fetch it now
         // (deep nodes are cache misses, the descent's main cost).
         __builtin_prefetch(nodes + at[q]);
       }
+    }
+  };
+  const bool unturned = crop.turn.sin == 0.0;
+  std::array<std::array<uint32_t, kPartForestClasses>, kBatch> sum{};
+  for (const PartForestTree& tree : trees_) {
+    const PartForestNode* nodes = tree.nodes.data();
+    std::array<uint32_t, kBatch> at{};
+    if (unturned) {
+      descend(tree, at, std::true_type{});
+    } else {
+      descend(tree, at, std::false_type{});
     }
     for (int p = 0; p < count; ++p) {
       const auto q = static_cast<size_t>(p);
@@ -454,8 +475,8 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
   const auto* mask = input.hand_mask.data();
   const HandPixels pixels{input};
 
-  // The hand's bounding box, copied with the background constant off the mask: probes then need
-  // one bounds check, and the crop is small enough to stay in cache. Storage is per thread and
+  // The hand's bounding box, copied with the background constant off the mask and in a border
+  // around it: a probe then needs a clamp, no branch, and the crop is small enough to stay in cache. Storage is per thread and
   // reused, with room for the whole image from a thread's first frame: a hand's box larger than
   // any before must not allocate (the daemon's steady state). So too the labels of a turned reading.
   int x0 = w, y0 = h, x1 = -1, y1 = -1;
@@ -464,17 +485,22 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
     uint8_t any = 0;
     for (int x = 0; x < w; ++x) any |= row[x];  // most rows have no hand: one vectorised pass
     if (any == 0) continue;
-    for (int x = 0; x < w; ++x) {
-      if (!pixels.labelled(x, y)) continue;
-      x0 = std::min(x0, x);
-      x1 = std::max(x1, x);
-      y0 = std::min(y0, y);
-      y1 = std::max(y1, y);
-    }
+    // The row's first and last labelled pixels, each found from its end of the row: a scan that
+    // stops at the hand, not one test per pixel of the row (unpredictable on the hand's edges).
+    int first = 0;
+    while (first < w && !pixels.labelled(first, y)) ++first;
+    if (first == w) continue;
+    int last = w - 1;
+    while (!pixels.labelled(last, y)) --last;
+    x0 = std::min(x0, first);
+    x1 = std::max(x1, last);
+    y0 = std::min(y0, y);
+    y1 = y;
   }
   thread_local std::vector<float> crop_storage;
   thread_local std::vector<uint8_t> turned_labels;
-  if (crop_storage.capacity() < n) crop_storage.reserve(n);
+  const size_t bordered = (static_cast<size_t>(w) + 2) * (static_cast<size_t>(h) + 2);
+  if (crop_storage.capacity() < bordered) crop_storage.reserve(bordered);
   if (turned_labels.capacity() < n) turned_labels.reserve(n);
   if (x1 < 0) return;
   Crop crop;
@@ -485,10 +511,15 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
   crop.focal_ratio_x = input.camera.fx / info_.reference_fx;
   crop.focal_ratio_y = input.camera.fy / info_.reference_fy;
   if (info_.hand_aligned) crop.turn = hand_turn(input.unhinted_axis);
-  crop_storage.resize(static_cast<size_t>(crop.width) * static_cast<size_t>(crop.height));
+  const float background = info_.background_mm;
+  const size_t stride = static_cast<size_t>(crop.width) + 2;
+  crop_storage.assign(stride * (static_cast<size_t>(crop.height) + 2), background);
   for (int y = y0; y <= y1; ++y) {
-    float* row = crop_storage.data() + static_cast<size_t>(y - y0) * static_cast<size_t>(crop.width);
-    for (int x = x0; x <= x1; ++x) row[x - x0] = pixels.labelled(x, y) ? input.filtered_mm[pixels.at(x, y)] : info_.background_mm;
+    float* row = crop_storage.data() + static_cast<size_t>(y - y0 + 1) * stride + 1;
+    const uint8_t* on = mask + pixels.at(x0, y);
+    const float* depth = input.filtered_mm.data() + pixels.at(x0, y);
+    // HandPixels::labelled without its branch (& for &&), so that the loop is vectorised.
+    for (int i = 0; i < crop.width; ++i) row[i] = ((on[i] != 0) & (depth[i] > 0.0F)) ? depth[i] : background;
   }
   crop.depth_mm = crop_storage.data();
   const uint64_t sure = label_hand(input, crop, labels);

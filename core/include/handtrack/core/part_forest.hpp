@@ -195,7 +195,9 @@ class PartForest final : public PixelLabeller {
     int block_y = 0;
   };
   struct Crop {
-    const float* depth_mm = nullptr;  // width x height: the hand's depth, the background elsewhere
+    // (width + 2) x (height + 2), row-major: the box's hand depth, the background elsewhere and in a
+    // one-pixel border around the box (box pixel (0, 0) is element width + 3).
+    const float* depth_mm = nullptr;
     int x0 = 0;                       // its top-left pixel in the image
     int y0 = 0;
     int width = 0;
