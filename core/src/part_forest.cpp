@@ -1,5 +1,7 @@
 #include "handtrack/core/part_forest.hpp"
 
+#include "forest_descent.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -402,7 +404,8 @@ uint64_t PartForest::classify_batch(const Crop& crop, const Site* sites, int cou
     const float d = probe(sites[p].x - crop.x0, sites[p].y - crop.y0);
     steps[static_cast<size_t>(p)] = probe_steps(sx, sy, d, crop.turn);
   }
-  // One tree's descent of the batch: at[p] ends on pixel p's leaf. The pixels descend in lockstep:
+  // One tree's descent of the batch, scalar (without AVX2, or PartForestOptions::simd_descent off;
+  // forest_descent.hpp is the vector one): at[p] ends on pixel p's leaf. The pixels descend in lockstep:
   // their node -> probe -> node chains are independent, so the CPU overlaps their memory and
   // multiply latencies (one chain alone is latency bound). Without a turn, or with a half turn, the
   // steps' cross terms xy and yx are 0 (probe_steps): `unturned` drops their multiplies, the same
@@ -441,15 +444,29 @@ uint64_t PartForest::classify_batch(const Crop& crop, const Site* sites, int cou
     }
   };
   const bool unturned = crop.turn.sin == 0.0;
+  static_assert(kBatch == kDescentLanes);
+  DescentLanes lanes;
+  if (options_.simd_descent) {
+    lanes.count = count;
+    for (int p = 0; p < (count + 7) / 8 * 8; ++p) {
+      const auto q = static_cast<size_t>(std::min(p, count - 1));
+      const auto l = static_cast<size_t>(p);
+      lanes.x[l] = sites[q].x - crop.x0;
+      lanes.y[l] = sites[q].y - crop.y0;
+      lanes.xx[l] = steps[q].xx;
+      lanes.xy[l] = steps[q].xy;
+      lanes.yx[l] = steps[q].yx;
+      lanes.yy[l] = steps[q].yy;
+    }
+  }
+  const DescentCrop descent_crop{depth, crop.width, crop.height};
   std::array<std::array<uint32_t, kPartForestClasses>, kBatch> sum{};
   for (const PartForestTree& tree : trees_) {
     const PartForestNode* nodes = tree.nodes.data();
-    std::array<uint32_t, kBatch> at{};
-    if (unturned) {
-      descend(tree, at, std::true_type{});
-    } else {
-      descend(tree, at, std::false_type{});
-    }
+    alignas(32) std::array<uint32_t, kBatch> at{};
+    const bool vectorised = options_.simd_descent && descend_avx2(tree, descent_crop, lanes, at.data());
+    if (!vectorised && unturned) descend(tree, at, std::true_type{});
+    if (!vectorised && !unturned) descend(tree, at, std::false_type{});
     for (int p = 0; p < count; ++p) {
       const auto q = static_cast<size_t>(p);
       const PartForestLeaf& leaf = tree.leaves[nodes[at[q]].leaf_index()];

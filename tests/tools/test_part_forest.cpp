@@ -761,6 +761,136 @@ TEST(SynthRenderPose, RenderingAMotionsPoseEqualsRenderingItsFrame) {
              b.joints[static_cast<size_t>(fingertip_joint(1))]).norm(), 10.0);
 }
 
+// The descent eight pixels at a time (PartForestOptions::simd_descent, AVX2) must give the scalar
+// descent's labels, pixel for pixel: the same 16.16 probe arithmetic in 32-bit lanes, the same
+// clamping to the border, the same comparison. Random trees whose offsets span the whole int16
+// range (probes far off the crop on every side) and whose thresholds straddle the depth
+// differences, over hands of random shape at 150-1500 mm whose axes point every way (so that the
+// turned readings, with their cross terms, are made too), at 320x240 and 640x480.
+bool cpu_has_avx2() {
+#if defined(__x86_64__)
+  return __builtin_cpu_supports("avx2");
+#else
+  return false;
+#endif
+}
+
+PartForestTree random_tree(std::mt19937& rng, int depth) {
+  std::uniform_int_distribution<int> offset(-32768, 32767);
+  std::uniform_real_distribution<float> threshold(-300.0F, 300.0F);
+  std::uniform_int_distribution<int> probability(0, 65535);
+  PartForestTree t;
+  // Breadth first, complete: node i's children are 2i + 1 and 2i + 2; the last level's nodes leaves.
+  const int internal = (1 << depth) - 1;
+  t.nodes.resize(static_cast<size_t>(2 * internal + 1));
+  for (int i = 0; i < static_cast<int>(t.nodes.size()); ++i) {
+    PartForestNode& n = t.nodes[static_cast<size_t>(i)];
+    if (i < internal) {
+      n.u = {static_cast<int16_t>(offset(rng)), static_cast<int16_t>(offset(rng))};
+      n.v = {static_cast<int16_t>(offset(rng) / 64), static_cast<int16_t>(offset(rng) / 64)};
+      n.threshold = threshold(rng);
+      n.child = static_cast<uint32_t>(2 * i + 1);
+      continue;
+    }
+    n.child = PartForestNode::kLeafBit | static_cast<uint32_t>(t.leaves.size());
+    PartForestLeaf leaf{};
+    for (auto& p : leaf) p = static_cast<uint16_t>(probability(rng));
+    leaf[0] = 1;  // never all zero
+    t.leaves.push_back(leaf);
+  }
+  return t;
+}
+
+DepthInput random_hand(std::mt19937& rng, int w, int h) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  DepthInput in = rectangle_input(w, h, 0.0F, 1, 1, 285.7 * w / 320.0);
+  const double depth = 150.0 + 1350.0 * unit(rng);
+  const double cx = w * (0.2 + 0.6 * unit(rng));
+  const double cy = h * (0.2 + 0.6 * unit(rng));
+  const double rx = w * (0.05 + 0.25 * unit(rng));
+  const double ry = h * (0.05 + 0.25 * unit(rng));
+  in.hand_pixels = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const auto i = static_cast<size_t>(y) * w + x;
+      const double e = std::pow((x - cx) / rx, 2) + std::pow((y - cy) / ry, 2);
+      const bool hand = e < 1.0;
+      in.hand_mask[i] = hand ? 1 : 0;
+      // Depth on the hand (a slope and noise, now and then a hole), and the scene around it.
+      in.filtered_mm[i] = hand && unit(rng) < 0.97 ? static_cast<float>(depth + 30.0 * e + 5.0 * unit(rng))
+                                                    : static_cast<float>(unit(rng) < 0.5 ? 0.0 : depth + 400.0 * unit(rng));
+      in.hand_pixels += hand ? 1 : 0;
+    }
+  }
+  const double angle = 2.0 * 3.14159265358979 * unit(rng);
+  in.finger_axis = Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.3 * (unit(rng) - 0.5)).normalized();
+  in.unhinted_axis = in.finger_axis;
+  return in;
+}
+
+TEST(PartForestFeatures, TheVectorDescentGivesTheScalarLabelsPixelForPixel) {
+  if (!cpu_has_avx2()) GTEST_SKIP() << "this CPU has no AVX2: both descents are the scalar one";
+  std::mt19937 rng(2015);
+  std::vector<PartForestTree> trees;
+  for (int t = 0; t < 3; ++t) trees.push_back(random_tree(rng, 10));
+  PartForestInfo info;
+  info.metadata = "random trees";
+  PartForestOptions vector_descent;
+  PartForestOptions scalar_descent;
+  scalar_descent.simd_descent = false;
+  for (const int stride : {1, 3}) {
+    vector_descent.stride_px = scalar_descent.stride_px = stride;
+    const PartForest fast(trees, info, vector_descent);
+    const PartForest reference(trees, info, scalar_descent);
+    int labelled = 0;
+    for (int i = 0; i < 40; ++i) {
+      const int w = i % 4 == 3 ? 640 : 320;
+      const DepthInput in = random_hand(rng, w, w * 3 / 4);
+      std::vector<uint8_t> a;
+      std::vector<uint8_t> b;
+      fast.label(in, a);
+      reference.label(in, b);
+      ASSERT_EQ(a, b) << "hand " << i << ", stride " << stride;
+      for (const uint8_t l : a) labelled += l != 0 ? 1 : 0;
+    }
+    EXPECT_GT(labelled, 10000) << "the hands must be labelled, not left background";
+  }
+}
+
+// The same with the shipped forest on rendered hands: every view, rolled so that the turned
+// readings are made, every 25th frame.
+TEST(ShippedPartForest, TheVectorDescentGivesTheScalarLabelsOnRenderedHands) {
+  if (!cpu_has_avx2()) GTEST_SKIP() << "this CPU has no AVX2: both descents are the scalar one";
+  const PartForest fast = PartForest::load(kShippedModel);
+  PartForestOptions scalar_descent;
+  scalar_descent.simd_descent = false;
+  const PartForest reference = PartForest::load(kShippedModel, scalar_descent);
+  DepthInputBuilder builder;
+  synth::SynthFrame f;
+  std::vector<uint8_t> a;
+  std::vector<uint8_t> b;
+  int frames = 0;
+  for (const synth::View view : synth::kViews) {
+    for (const double roll : {0.0, 60.0, 180.0}) {
+      synth::SynthOptions o;
+      o.motion = "random";
+      o.view = view;
+      o.roll_deg = roll;
+      o.seed = 77;
+      synth::SyntheticCamera cam(o);
+      for (int i = 0; i < o.frames; i += 25) {
+        cam.render(i, f);
+        const DepthInput& in = builder.build(f.depth, std::nullopt);
+        fast.label(in, a);
+        reference.label(in, b);
+        ASSERT_EQ(a, b) << synth::view_name(view) << " rolled " << roll << ", frame " << i;
+        ++frames;
+      }
+    }
+  }
+  EXPECT_EQ(frames, 6 * 3 * 12);
+}
+
 TEST(ShippedPartForest, LoadsAndLabelsHeldOutSyntheticHandsAtLeast60PercentRight) {
   ASSERT_TRUE(fs::exists(kShippedModel)) << kShippedModel;
   const PartForest model = PartForest::load(kShippedModel);

@@ -106,6 +106,9 @@ struct PartForestOptions {
   // the nearest multiple of 45 deg (eighth_turn), and keeps the labelling its trees are surer of
   // (ours; docs/FOREST.md, "A hand from another image edge").
   bool turned_readings = true;
+  // The descent eight pixels at a time in AVX2 registers where the CPU has them (the same labels
+  // bit for bit; src/forest_descent.hpp); false: the scalar descent, which the tests compare it with.
+  bool simd_descent = true;
 };
 
 // Probe arithmetic, shared by training and inference so that both round alike, in 16.16 fixed
