@@ -1,10 +1,48 @@
 #include "median_filter.hpp"
 
+#include "target_clones.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 namespace handtrack {
+
+namespace {
+
+// The three passes of the 3x3 median, each a loop of min and max (exact at any vector width),
+// compiled for AVX-512, AVX2 and the baseline (target_clones.hpp).
+
+// Non-finite samples as 0 (no depth).
+HANDTRACK_TARGET_CLONES void clean_depth(const float* __restrict in, size_t n, float* __restrict out) {
+  for (size_t i = 0; i < n; ++i) out[i] = std::abs(in[i]) <= std::numeric_limits<float>::max() ? in[i] : 0.0F;
+}
+
+// Sorts the column triples (a[u], b[u], c[u]) of three rows into lo[u] <= mid[u] <= hi[u].
+HANDTRACK_TARGET_CLONES void sort_columns(const float* __restrict a, const float* __restrict b,
+                                          const float* __restrict c, int n, float* __restrict lo,
+                                          float* __restrict mid, float* __restrict hi) {
+  for (int u = 0; u < n; ++u) {
+    const float ab_lo = std::min(a[u], b[u]);
+    const float ab_hi = std::max(a[u], b[u]);
+    lo[u] = std::min(ab_lo, c[u]);
+    hi[u] = std::max(ab_hi, c[u]);
+    mid[u] = std::max(ab_lo, std::min(ab_hi, c[u]));
+  }
+}
+
+// One output row from the sorted triples of its window's columns, padded by one on each side.
+HANDTRACK_TARGET_CLONES void median_row(const float* __restrict lo, const float* __restrict mid,
+                                        const float* __restrict hi, int n, float* __restrict out) {
+  for (int u = 0; u < n; ++u) {
+    const float max_lo = std::max(std::max(lo[u], lo[u + 1]), lo[u + 2]);
+    const float min_hi = std::min(std::min(hi[u], hi[u + 1]), hi[u + 2]);
+    const float med_mid = std::max(std::min(mid[u], mid[u + 1]), std::min(std::max(mid[u], mid[u + 1]), mid[u + 2]));
+    out[u] = std::max(std::min(max_lo, med_mid), std::min(std::max(max_lo, med_mid), min_hi));
+  }
+}
+
+}  // namespace
 
 const std::vector<float>& MedianFilter::apply(const DepthImage& depth, int radius) {
   out_.resize(depth.depth_mm.size());
@@ -23,12 +61,8 @@ const std::vector<float>& MedianFilter::apply(const DepthImage& depth, int radiu
 void MedianFilter::median_3x3(const DepthImage& depth) {
   const int w = depth.width();
   const int h = depth.height();
-  // Non-finite samples count as 0 (no depth).
   clean_.resize(depth.depth_mm.size());
-  for (size_t i = 0; i < clean_.size(); ++i) {
-    const float d = depth.depth_mm[i];
-    clean_[i] = std::abs(d) <= std::numeric_limits<float>::max() ? d : 0.0F;
-  }
+  clean_depth(depth.depth_mm.data(), clean_.size(), clean_.data());
   const auto row = [&](int v) { return clean_.data() + static_cast<size_t>(std::clamp(v, 0, h - 1)) * w; };
   // Column triples of the current window rows, padded by one column on each side.
   lo_.resize(static_cast<size_t>(w) + 2);
@@ -48,24 +82,7 @@ void MedianFilter::median_3x3(const DepthImage& depth) {
     lo[w + 1] = lo[w];
     mid[w + 1] = mid[w];
     hi[w + 1] = hi[w];
-    float* __restrict out = out_.data() + static_cast<size_t>(v) * w;
-    for (int u = 0; u < w; ++u) {
-      const float max_lo = std::max(std::max(lo[u], lo[u + 1]), lo[u + 2]);
-      const float min_hi = std::min(std::min(hi[u], hi[u + 1]), hi[u + 2]);
-      const float med_mid = std::max(std::min(mid[u], mid[u + 1]), std::min(std::max(mid[u], mid[u + 1]), mid[u + 2]));
-      out[u] = std::max(std::min(max_lo, med_mid), std::min(std::max(max_lo, med_mid), min_hi));
-    }
-  }
-}
-
-void MedianFilter::sort_columns(const float* __restrict a, const float* __restrict b, const float* __restrict c,
-                                     int n, float* __restrict lo, float* __restrict mid, float* __restrict hi) {
-  for (int u = 0; u < n; ++u) {
-    const float ab_lo = std::min(a[u], b[u]);
-    const float ab_hi = std::max(a[u], b[u]);
-    lo[u] = std::min(ab_lo, c[u]);
-    hi[u] = std::max(ab_hi, c[u]);
-    mid[u] = std::max(ab_lo, std::min(ab_hi, c[u]));
+    median_row(lo, mid, hi, w, out_.data() + static_cast<size_t>(v) * w);
   }
 }
 

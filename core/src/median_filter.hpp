@@ -18,9 +18,6 @@ class MedianFilter {
 
  private:
   void median_3x3(const DepthImage& depth);
-  // Sorts the column triples (a[u], b[u], c[u]) of three rows into lo[u] <= mid[u] <= hi[u].
-  static void sort_columns(const float* __restrict a, const float* __restrict b, const float* __restrict c, int n,
-                           float* __restrict lo, float* __restrict mid, float* __restrict hi);
   void median_any(const DepthImage& depth, int radius);
 
   std::vector<float> out_;
