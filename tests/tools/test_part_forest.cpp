@@ -19,6 +19,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -766,7 +767,8 @@ TEST(SynthRenderPose, RenderingAMotionsPoseEqualsRenderingItsFrame) {
 // clamping to the border, the same comparison. Random trees whose offsets span the whole int16
 // range (probes far off the crop on every side) and whose thresholds straddle the depth
 // differences, over hands of random shape at 150-1500 mm whose axes point every way (so that the
-// turned readings, with their cross terms, are made too), at 320x240 and 640x480.
+// turned readings, with their cross terms, are made too, and a hand-aligned forest's probes turn
+// by any angle), at 320x240 and 640x480.
 bool cpu_has_avx2() {
 #if defined(__x86_64__)
   return __builtin_cpu_supports("avx2");
@@ -838,8 +840,9 @@ TEST(PartForestFeatures, TheVectorDescentGivesTheScalarLabelsPixelForPixel) {
   PartForestOptions vector_descent;
   PartForestOptions scalar_descent;
   scalar_descent.simd_descent = false;
-  for (const int stride : {1, 3}) {
+  for (const auto& [stride, hand_aligned] : {std::pair{1, false}, std::pair{3, false}, std::pair{3, true}}) {
     vector_descent.stride_px = scalar_descent.stride_px = stride;
+    info.hand_aligned = hand_aligned;
     const PartForest fast(trees, info, vector_descent);
     const PartForest reference(trees, info, scalar_descent);
     int labelled = 0;
@@ -850,7 +853,7 @@ TEST(PartForestFeatures, TheVectorDescentGivesTheScalarLabelsPixelForPixel) {
       std::vector<uint8_t> b;
       fast.label(in, a);
       reference.label(in, b);
-      ASSERT_EQ(a, b) << "hand " << i << ", stride " << stride;
+      ASSERT_EQ(a, b) << "hand " << i << ", stride " << stride << (hand_aligned ? ", hand-aligned" : "");
       for (const uint8_t l : a) labelled += l != 0 ? 1 : 0;
     }
     EXPECT_GT(labelled, 10000) << "the hands must be labelled, not left background";
