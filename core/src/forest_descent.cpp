@@ -13,6 +13,8 @@ namespace handtrack {
 
 namespace {
 
+// The largest step (16.16) whose probe sums stay within 32 bits: |u| <= 2^15, so each product is
+// within 2^29 and the sum of two with the rounding half below 2^31 (forest_descent.hpp).
 constexpr int32_t kMaxLaneStep = 1 << 14;
 
 // A node as four 32-bit words: (u_x, u_y) as two int16, (v_x, v_y) likewise, the threshold, the
@@ -23,6 +25,7 @@ constexpr int kWordThreshold = 2;
 constexpr int kWordChild = 3;
 static_assert(sizeof(PartForestNode) == 4 * sizeof(int32_t));
 
+// Whether every lane's steps, the padding's included, are within kMaxLaneStep.
 bool steps_fit(const DescentLanes& lanes) {
   const int n = (lanes.count + 7) / 8 * 8;
   int32_t largest = 0;
@@ -33,6 +36,7 @@ bool steps_fit(const DescentLanes& lanes) {
   return largest <= kMaxLaneStep;
 }
 
+// The batch's descent, a group of eight lanes a register (descend_avx2).
 __attribute__((target("avx2"))) void descend8(const PartForestTree& tree, const DescentCrop& crop,
                                               const DescentLanes& lanes, uint32_t* at) {
   const auto* words = reinterpret_cast<const int32_t*>(tree.nodes.data());

@@ -405,11 +405,11 @@ uint64_t PartForest::classify_batch(const Crop& crop, const Site* sites, int cou
     steps[static_cast<size_t>(p)] = probe_steps(sx, sy, d, crop.turn);
   }
   // One tree's descent of the batch, scalar (without AVX2, or PartForestOptions::simd_descent off;
-  // forest_descent.hpp is the vector one): at[p] ends on pixel p's leaf. The pixels descend in lockstep:
-  // their node -> probe -> node chains are independent, so the CPU overlaps their memory and
-  // multiply latencies (one chain alone is latency bound). Without a turn, or with a half turn, the
-  // steps' cross terms xy and yx are 0 (probe_steps): `unturned` drops their multiplies, the same
-  // sums (16 % of the descent on 2026-12-03's host).
+  // forest_descent.hpp is the vector one): at[p] ends on pixel p's leaf. The pixels descend in
+  // lockstep: their node -> probe -> node chains are independent, so the CPU overlaps their memory
+  // and multiply latencies (one chain alone is latency bound). Without a turn, or with a half turn,
+  // the steps' cross terms xy and yx are 0 (probe_steps): `unturned` drops their multiplies, the
+  // same sums (16 % of the scalar descent on 2026-12-03's host).
   const auto descend = [&](const PartForestTree& tree, std::array<uint32_t, kBatch>& at, auto unturned) {
     const PartForestNode* nodes = tree.nodes.data();
     const auto coordinate = [](int c, int16_t a, int16_t b, int32_t ka, int32_t kb) {
@@ -493,9 +493,10 @@ void PartForest::label(const DepthInput& input, std::vector<uint8_t>& labels) co
   const HandPixels pixels{input};
 
   // The hand's bounding box, copied with the background constant off the mask and in a border
-  // around it: a probe then needs a clamp, no branch, and the crop is small enough to stay in cache. Storage is per thread and
-  // reused, with room for the whole image from a thread's first frame: a hand's box larger than
-  // any before must not allocate (the daemon's steady state). So too the labels of a turned reading.
+  // around it: a probe then needs a clamp, no branch, and the crop is small enough to stay in
+  // cache. Storage is per thread and reused, with room for the whole image from a thread's first
+  // frame: a hand's box larger than any before must not allocate (the daemon's steady state). So
+  // too the labels of a turned reading.
   int x0 = w, y0 = h, x1 = -1, y1 = -1;
   for (int y = 0; y < h; ++y) {
     const uint8_t* row = mask + pixels.at(0, y);
