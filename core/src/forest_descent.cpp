@@ -25,17 +25,6 @@ constexpr int kWordThreshold = 2;
 constexpr int kWordChild = 3;
 static_assert(sizeof(PartForestNode) == 4 * sizeof(int32_t));
 
-// Whether every lane's steps, the padding's included, are within kMaxLaneStep.
-bool steps_fit(const DescentLanes& lanes) {
-  const int n = (lanes.count + 7) / 8 * 8;
-  int32_t largest = 0;
-  for (int p = 0; p < n; ++p) {
-    const auto q = static_cast<size_t>(p);
-    for (const int32_t k : {lanes.xx[q], lanes.xy[q], lanes.yx[q], lanes.yy[q]}) largest = std::max(largest, std::abs(k));
-  }
-  return largest <= kMaxLaneStep;
-}
-
 // The batch's descent, a group of eight lanes a register (descend_avx2).
 __attribute__((target("avx2"))) void descend8(const PartForestTree& tree, const DescentCrop& crop,
                                               const DescentLanes& lanes, uint32_t* at) {
@@ -121,17 +110,27 @@ bool avx2_descent_supported() {
   return supported;
 }
 
-bool descend_avx2(const PartForestTree& tree, const DescentCrop& crop, const DescentLanes& lanes, uint32_t* at) {
-  if (!avx2_descent_supported() || !steps_fit(lanes)) return false;
+bool lanes_fit_avx2(const DescentLanes& lanes) {
+  const int n = (lanes.count + 7) / 8 * 8;
+  int32_t largest = 0;
+  for (int p = 0; p < n; ++p) {
+    const auto q = static_cast<size_t>(p);
+    for (const int32_t k : {lanes.xx[q], lanes.xy[q], lanes.yx[q], lanes.yy[q]}) largest = std::max(largest, std::abs(k));
+  }
+  return largest <= kMaxLaneStep;
+}
+
+void descend_avx2(const PartForestTree& tree, const DescentCrop& crop, const DescentLanes& lanes, uint32_t* at) {
   descend8(tree, crop, lanes, at);
-  return true;
 }
 
 #else
 
 bool avx2_descent_supported() { return false; }
 
-bool descend_avx2(const PartForestTree&, const DescentCrop&, const DescentLanes&, uint32_t*) { return false; }
+bool lanes_fit_avx2(const DescentLanes&) { return false; }
+
+void descend_avx2(const PartForestTree&, const DescentCrop&, const DescentLanes&, uint32_t*) {}
 
 #endif
 

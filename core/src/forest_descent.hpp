@@ -46,8 +46,12 @@ struct DescentCrop {
 // Whether this CPU runs descend_avx2 (x86-64 with AVX2; never elsewhere).
 bool avx2_descent_supported();
 
+// Whether every step of the batch, the padding's included, is within 2^14: the batch descend_avx2
+// may take (decided once a batch, for all the trees).
+bool lanes_fit_avx2(const DescentLanes& lanes);
+
 // Descends `tree` for the batch: at[p] is pixel p's leaf node (at: kDescentLanes entries, 32-byte
-// aligned). Returns false, having done nothing, where the CPU lacks AVX2 or a step is beyond 2^14.
-bool descend_avx2(const PartForestTree& tree, const DescentCrop& crop, const DescentLanes& lanes, uint32_t* at);
+// aligned). Only where avx2_descent_supported() and lanes_fit_avx2(lanes).
+void descend_avx2(const PartForestTree& tree, const DescentCrop& crop, const DescentLanes& lanes, uint32_t* at);
 
 }  // namespace handtrack

@@ -445,8 +445,11 @@ uint64_t PartForest::classify_batch(const Crop& crop, const Site* sites, int cou
   };
   const bool unturned = crop.turn.sin == 0.0;
   static_assert(kBatch == kDescentLanes);
+  // The vector descent where this CPU has it and the batch's steps fit its lanes: decided once for
+  // all the trees.
   DescentLanes lanes;
-  if (options_.simd_descent) {
+  bool vectorised = options_.simd_descent && avx2_descent_supported();
+  if (vectorised) {
     lanes.count = count;
     for (int p = 0; p < (count + 7) / 8 * 8; ++p) {
       const auto q = static_cast<size_t>(std::min(p, count - 1));
@@ -458,15 +461,20 @@ uint64_t PartForest::classify_batch(const Crop& crop, const Site* sites, int cou
       lanes.yx[l] = steps[q].yx;
       lanes.yy[l] = steps[q].yy;
     }
+    vectorised = lanes_fit_avx2(lanes);
   }
   const DescentCrop descent_crop{depth, crop.width, crop.height};
   std::array<std::array<uint32_t, kPartForestClasses>, kBatch> sum{};
   for (const PartForestTree& tree : trees_) {
     const PartForestNode* nodes = tree.nodes.data();
     alignas(32) std::array<uint32_t, kBatch> at{};
-    const bool vectorised = options_.simd_descent && descend_avx2(tree, descent_crop, lanes, at.data());
-    if (!vectorised && unturned) descend(tree, at, std::true_type{});
-    if (!vectorised && !unturned) descend(tree, at, std::false_type{});
+    if (vectorised) {
+      descend_avx2(tree, descent_crop, lanes, at.data());
+    } else if (unturned) {
+      descend(tree, at, std::true_type{});
+    } else {
+      descend(tree, at, std::false_type{});
+    }
     for (int p = 0; p < count; ++p) {
       const auto q = static_cast<size_t>(p);
       const PartForestLeaf& leaf = tree.leaves[nodes[at[q]].leaf_index()];
