@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
 """Runs handtrack-bench briefly and checks its JSON against SPEC.md "Benchmark output"."""
+import csv
 import json
 import math
 import subprocess
@@ -66,6 +67,24 @@ for name, entry in sorted(repeated.items()):
         failures.append(f"--runs 3, {name}: runs {entry.get('runs')!r}, fps_runs {fps_runs!r}")
     elif entry["fps"] != sorted(fps_runs)[1]:
         failures.append(f"--runs 3, {name}: fps {entry['fps']!r} is not the median of {fps_runs!r}")
+# --frames-csv: a row per frame of every run of every configuration measured; a late-fusion run's
+# first frame is its (re)start search (hundreds of iterations), a tracked frame 2 particles x 10.
+frames_csv = out + ".frames.csv"
+subprocess.run([exe, "--frames", "12", "--runs", "2", "--only", "late_fusion_2p_10it", "--only", "depth_only_1p_10it",
+                "--frames-csv", frames_csv], check=True, stdout=subprocess.DEVNULL)
+with open(frames_csv) as f:
+    rows = list(csv.DictReader(f))
+keys = sorted({(r["configuration"], r["run"]) for r in rows})
+if keys != [(c, r) for c in ("depth_only_1p_10it", "late_fusion_2p_10it") for r in ("0", "1")] or len(rows) != 48:
+    failures.append(f"--frames-csv: {len(rows)} rows of {keys!r}")
+else:
+    late = [r for r in rows if r["configuration"] == "late_fusion_2p_10it" and r["run"] == "0"]
+    if [r["frame"] for r in late] != [str(i) for i in range(12)]:
+        failures.append(f"--frames-csv: frames {[r['frame'] for r in late]!r}")
+    if int(late[0]["iterations"]) < 100 or not all(int(r["iterations"]) >= 20 for r in late):
+        failures.append(f"--frames-csv: iterations {[r['iterations'] for r in late]!r}")
+    if not all(float(r["preprocess_ms"]) > 0 and float(r["optimize_ms"]) > 0 and r["hands"] == "1" for r in late):
+        failures.append(f"--frames-csv: {late[1]!r}")
 bad_runs = subprocess.run([exe, "--runs", "0"], capture_output=True, text=True)
 if bad_runs.returncode == 0 or len(bad_runs.stderr.strip().splitlines()) != 1 or "--runs" not in bad_runs.stderr:
     failures.append(f"--runs 0: exit {bad_runs.returncode}, stderr {bad_runs.stderr!r}")

@@ -78,6 +78,14 @@ struct Measurement {
   double p99_ms = 0.0;
   double hands_per_frame = 0.0;
   double hand_overlap = 0.0;
+  // Each frame's own figures, for --frames-csv.
+  struct Frame {
+    double preprocess_ms;
+    double optimize_ms;
+    int hands;
+    int iterations;  // the optimiser's, all hands together (TrackerOutput::iterations)
+  };
+  std::vector<Frame> frames;
 };
 
 // The median over runs of one figure of theirs (of an even count, the mean of the middle two).
@@ -94,6 +102,7 @@ double median_of(const std::vector<Measurement>& runs, double Measurement::*figu
 int main(int argc, char** argv) {
   CLI::App app{"The paper's speed table: every configuration on the same synthetic 320x240 frames, one thread."};
   std::string json_file;
+  std::string frames_csv;
   std::string forest_file = shipped_forest_path().value_or("");
   std::string motion = "random";
   std::string two_hand_motion = "two_apart";
@@ -101,6 +110,9 @@ int main(int argc, char** argv) {
   uint64_t seed = 7;
   std::vector<std::string> only;
   app.add_option("--json", json_file, "write the table as JSON (SPEC.md)");
+  app.add_option("--frames-csv", frames_csv,
+                 "write each frame's figures as CSV: configuration,run,frame,preprocess_ms,optimize_ms,hands,"
+                 "iterations (a search or a handedness trial shows as a frame of hundreds of iterations)");
   app.add_option("--forest", forest_file, "part forest for the late-fusion configuration")->check(CLI::ExistingFile);
   app.add_option("--motion", motion, "synthetic motion to track");
   app.add_option("--two-hand-motion", two_hand_motion, "synthetic two-hand scene of the two-hand configurations");
@@ -169,6 +181,7 @@ int main(int argc, char** argv) {
       const DepthImage* depth = nullptr;
       const std::function<void()> build_second = [&] { inputs.build_slot(1, *depth, request, labeller); };
       const std::function<void()> fit_second = [&] { tracker.fit(1, inputs); };
+      Measurement m;
       std::vector<double> pre_ms, opt_ms, latency_ms;
       double hands = 0.0;
       double hand_ms = 0.0;  // sum over frames and hands of each hand's own optimisation
@@ -189,10 +202,14 @@ int main(int argc, char** argv) {
         opt_total_ms += opt_ms.back();
         latency_ms.push_back(pre_ms.back() + opt_ms.back());
         hands += result.count;
-        for (int k = 0; k < result.count; ++k) hand_ms += result.optimize_ms[static_cast<size_t>(k)];
+        int iterations = 0;
+        for (int k = 0; k < result.count; ++k) {
+          hand_ms += result.optimize_ms[static_cast<size_t>(k)];
+          iterations += result.hands[static_cast<size_t>(k)].iterations;
+        }
+        m.frames.push_back({pre_ms.back(), opt_ms.back(), result.count, iterations});
         done_share(static_cast<double>(i + 1) / frames);
       }
-      Measurement m;
       m.fps = frames / (ms_since(start) / 1000.0);
       m.preprocess_ms = percentile(pre_ms, 0.5);
       m.optimize_ms = percentile(opt_ms, 0.5);
@@ -256,6 +273,21 @@ int main(int argc, char** argv) {
                       {"fps_runs", fps_runs}};
       std::printf("%-48s %8.1f %14.2f %12.2f %9.2f/%.2f %8.2f%s\n", bc.name.c_str(), fps, pre, opt, p50, p99, overlap,
                   runs > 1 ? (" " + fps_list).c_str() : "");
+    }
+    if (!frames_csv.empty()) {
+      std::ofstream f(frames_csv);
+      if (!f) throw std::runtime_error(frames_csv + ": cannot write");
+      f << "configuration,run,frame,preprocess_ms,optimize_ms,hands,iterations\n";
+      for (size_t c = 0; c < chosen.size(); ++c) {
+        for (size_t r = 0; r < runs_of[c].size(); ++r) {
+          const std::vector<Measurement::Frame>& fr = runs_of[c][r].frames;
+          for (size_t i = 0; i < fr.size(); ++i) {
+            f << chosen[c]->name << ',' << r << ',' << i << ',' << fr[i].preprocess_ms << ',' << fr[i].optimize_ms
+              << ',' << fr[i].hands << ',' << fr[i].iterations << '\n';
+          }
+        }
+      }
+      if (!f) throw std::runtime_error(frames_csv + ": cannot write");
     }
     if (!json_file.empty()) {
       std::ofstream f(json_file);
