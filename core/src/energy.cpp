@@ -192,11 +192,15 @@ inline Overlap3d overlap_3d_pair(double dist2, double sigma2_a, double sigma2_b,
 constexpr size_t kCollisionChunk = 128;
 
 // D_ab of each pair (eq. 8, overlap_3d_pair), with the Gaussians' centres and sigma^2 as arrays;
-// stores D_ab / S per pair and returns sum D_ab.
-HANDTRACK_TARGET_CLONES double collision_overlaps(
-    const CollisionPair* pairs, size_t count, const double* x, const double* y, const double* z,
-    const double* sigma2, double* d_over_s) {
+// returns sum D_ab and stores each pair's dE/dmu_a = -D_ab / S (mu_a - mu_b) / E(C_h, C_h)
+// (`inv_norm`) in `de` (3 x kCollisionChunk: x, then y, then z), vectorised with the rest.
+HANDTRACK_TARGET_CLONES double collision_overlaps(const CollisionPair* pairs, size_t count, const double* x,
+                                                  const double* y, const double* z, const double* sigma2,
+                                                  double inv_norm, double* de) {
   const double norm_3d = std::pow(2.0 * std::numbers::pi, 1.5);
+  double* const de_x = de;
+  double* const de_y = de + kCollisionChunk;
+  double* const de_z = de + 2 * kCollisionChunk;
   double energy = 0.0;
 #pragma omp simd reduction(+ : energy)
   for (size_t k = 0; k < count; ++k) {
@@ -207,7 +211,10 @@ HANDTRACK_TARGET_CLONES double collision_overlaps(
     const double dz = z[a] - z[b];
     const Overlap3d o = overlap_3d_pair(dx * dx + dy * dy + dz * dz, sigma2[a], sigma2[b], norm_3d);
     energy += o.d;
-    d_over_s[k] = o.d_over_s;
+    const double s = -o.d_over_s * inv_norm;
+    de_x[k] = s * dx;
+    de_y[k] = s * dy;
+    de_z[k] = s * dz;
   }
   return energy;
 }
@@ -381,18 +388,52 @@ double CollisionTerm::evaluate_centres(const HandModel& model, const PosedHand& 
   }
   const double inv_norm = 1.0 / model.self_similarity();
   const auto& pairs = model.collision_pairs();
-  std::array<double, kCollisionChunk> d_over_s{};
+  // Each chunk's dE/dmu_a per pair (x, y, z), then scattered to the columns: into three arrays,
+  // each sum in the pairs' order as into the columns themselves. The pairs come ordered by a (then
+  // b, HandModel), so a's sums run in registers along each run of pairs of one a.
+  std::array<double, 3 * kCollisionChunk> de;
+  std::array<double, kMaxModelGaussians> gx{};
+  std::array<double, kMaxModelGaussians> gy{};
+  std::array<double, kMaxModelGaussians> gz{};
+  const bool want = dE_dcentres != nullptr;
+  if (want) {
+    for (size_t i = 0; i < n; ++i) {
+      gx[i] = (*dE_dcentres)(0, static_cast<Eigen::Index>(i));
+      gy[i] = (*dE_dcentres)(1, static_cast<Eigen::Index>(i));
+      gz[i] = (*dE_dcentres)(2, static_cast<Eigen::Index>(i));
+    }
+  }
   double energy = 0.0;
   for (size_t begin = 0; begin < pairs.size(); begin += kCollisionChunk) {
     const size_t count = std::min(kCollisionChunk, pairs.size() - begin);
-    energy += collision_overlaps(pairs.data() + begin, count, x.data(), y.data(), z.data(), sigma2.data(),
-                                 d_over_s.data());
-    if (dE_dcentres == nullptr) continue;
-    for (size_t k = 0; k < count; ++k) {
-      const auto& pair = pairs[begin + k];
-      const Vector3d de_da = -d_over_s[k] * inv_norm * (hand.centre(pair.a) - hand.centre(pair.b));
-      dE_dcentres->col(pair.a) += de_da;
-      dE_dcentres->col(pair.b) -= de_da;
+    energy += collision_overlaps(pairs.data() + begin, count, x.data(), y.data(), z.data(), sigma2.data(), inv_norm,
+                                 de.data());
+    if (!want) continue;
+    size_t k = 0;
+    while (k < count) {
+      const auto a = static_cast<size_t>(pairs[begin + k].a);
+      double ax = gx[a];
+      double ay = gy[a];
+      double az = gz[a];
+      for (; k < count && static_cast<size_t>(pairs[begin + k].a) == a; ++k) {
+        const auto b = static_cast<size_t>(pairs[begin + k].b);
+        ax += de[k];
+        ay += de[kCollisionChunk + k];
+        az += de[2 * kCollisionChunk + k];
+        gx[b] -= de[k];
+        gy[b] -= de[kCollisionChunk + k];
+        gz[b] -= de[2 * kCollisionChunk + k];
+      }
+      gx[a] = ax;
+      gy[a] = ay;
+      gz[a] = az;
+    }
+  }
+  if (want) {
+    for (size_t i = 0; i < n; ++i) {
+      (*dE_dcentres)(0, static_cast<Eigen::Index>(i)) = gx[i];
+      (*dE_dcentres)(1, static_cast<Eigen::Index>(i)) = gy[i];
+      (*dE_dcentres)(2, static_cast<Eigen::Index>(i)) = gz[i];
     }
   }
   return energy * inv_norm;
