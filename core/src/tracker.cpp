@@ -579,8 +579,12 @@ TrackerOutput PoseTracker::optimise(const DepthInput& input) {
       check_ = Check{true, next_check_, place, input.hand_centroid_mm, StartSearch::hypothesis_count(place), 0, 0, {}};
       search_.clear();
       next_check_ = CheckCause::kNone;
+      // Spread over frames, the search starts on the next frame: this one's preprocessing, the
+      // fresh segmentation, costs up to three times a tracked frame's, and a search slice on top
+      // of it made it the slowest frame of a check (docs/BENCHMARKS.md, "A check's first frame").
+      if (config_.check_iterations_per_frame > 0) check = CheckOutcome::kChecking;
     }
-    if (check_.active) {
+    if (check_.active && check == CheckOutcome::kNone) {
       fresh = continue_check(input, explained);
       check = fresh ? CheckOutcome::kRestartWon : check_.active ? CheckOutcome::kChecking : CheckOutcome::kTrackedKept;
     }
