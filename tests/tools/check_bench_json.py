@@ -85,6 +85,13 @@ else:
         failures.append(f"--frames-csv: iterations {[r['iterations'] for r in late]!r}")
     if not all(float(r["preprocess_ms"]) > 0 and float(r["optimize_ms"]) > 0 and r["hands"] == "1" for r in late):
         failures.append(f"--frames-csv: {late[1]!r}")
+# An output that cannot be written is one error line before anything is measured (a full run here
+# takes minutes; the timeout says it did not run).
+for option in ("--json", "--frames-csv"):
+    unwritable = subprocess.run([exe, option, "/nonexistent-dir/out"], capture_output=True, text=True, timeout=10)
+    lines = unwritable.stderr.strip().splitlines()
+    if unwritable.returncode == 0 or len(lines) != 1 or "/nonexistent-dir/out" not in lines[0]:
+        failures.append(f"{option} /nonexistent-dir/out: exit {unwritable.returncode}, stderr {unwritable.stderr!r}")
 bad_runs = subprocess.run([exe, "--runs", "0"], capture_output=True, text=True)
 if bad_runs.returncode == 0 or len(bad_runs.stderr.strip().splitlines()) != 1 or "--runs" not in bad_runs.stderr:
     failures.append(f"--runs 0: exit {bad_runs.returncode}, stderr {bad_runs.stderr!r}")

@@ -129,6 +129,17 @@ int main(int argc, char** argv) {
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
 
   try {
+    // The output files opened before anything is measured: a path that cannot be written is one
+    // error line at once, not after minutes of measuring.
+    const auto open_output = [](const std::string& path, std::ofstream& stream) {
+      if (path.empty()) return;
+      stream.open(path);
+      if (!stream) throw std::runtime_error(path + ": cannot write");
+    };
+    std::ofstream json_out;
+    std::ofstream frames_out;
+    open_output(json_file, json_out);
+    open_output(frames_csv, frames_out);
     const PartForest forest = PartForest::load(forest_file);
     CameraIntrinsics camera;
 
@@ -274,25 +285,22 @@ int main(int argc, char** argv) {
       std::printf("%-48s %8.1f %14.2f %12.2f %9.2f/%.2f %8.2f%s\n", bc.name.c_str(), fps, pre, opt, p50, p99, overlap,
                   runs > 1 ? (" " + fps_list).c_str() : "");
     }
-    if (!frames_csv.empty()) {
-      std::ofstream f(frames_csv);
-      if (!f) throw std::runtime_error(frames_csv + ": cannot write");
-      f << "configuration,run,frame,preprocess_ms,optimize_ms,hands,iterations\n";
+    if (frames_out.is_open()) {
+      frames_out << "configuration,run,frame,preprocess_ms,optimize_ms,hands,iterations\n";
       for (size_t c = 0; c < chosen.size(); ++c) {
         for (size_t r = 0; r < runs_of[c].size(); ++r) {
           const std::vector<Measurement::Frame>& fr = runs_of[c][r].frames;
           for (size_t i = 0; i < fr.size(); ++i) {
-            f << chosen[c]->name << ',' << r << ',' << i << ',' << fr[i].preprocess_ms << ',' << fr[i].optimize_ms
-              << ',' << fr[i].hands << ',' << fr[i].iterations << '\n';
+            frames_out << chosen[c]->name << ',' << r << ',' << i << ',' << fr[i].preprocess_ms << ','
+                       << fr[i].optimize_ms << ',' << fr[i].hands << ',' << fr[i].iterations << '\n';
           }
         }
       }
-      if (!f) throw std::runtime_error(frames_csv + ": cannot write");
+      if (!frames_out.flush()) throw std::runtime_error(frames_csv + ": cannot write");
     }
-    if (!json_file.empty()) {
-      std::ofstream f(json_file);
-      if (!f) throw std::runtime_error(json_file + ": cannot write");
-      f << out.dump(2) << "\n";
+    if (json_out.is_open()) {
+      json_out << out.dump(2) << "\n";
+      if (!json_out.flush()) throw std::runtime_error(json_file + ": cannot write");
     }
   } catch (const std::exception& e) {
     return report_error(kProgram, e.what(), 1);
