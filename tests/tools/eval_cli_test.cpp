@@ -91,6 +91,19 @@ TEST_F(EvalCli, NoScorableFrameIsAnErrorNotNan) {
   EXPECT_EQ(err.find("nan"), std::string::npos) << err;
 }
 
+// Every output file is opened before anything is tracked: an unwritable path is refused with one
+// line at once, not after an evaluation of many minutes (on the empty sequence the tracking would
+// end in "no frame could be scored", which came first while the outputs were opened at the end).
+TEST_F(EvalCli, AnUnwritableOutputIsRefusedBeforeAnythingIsTracked) {
+  const std::string seq = "'" + (dir_ / "seq").string() + "'";
+  const std::string unwritable = (dir_ / "no-such-dir" / "out").string();
+  for (const std::string option : {"--json", "--csv", "--plot", "--tips-csv", "--joints-csv"}) {
+    std::string err;
+    EXPECT_NE(eval(&err, seq + " " + option + " '" + unwritable + "'"), 0) << option;
+    EXPECT_EQ(err, "handtrack-eval: error: " + unwritable + ": cannot write\n") << option;
+  }
+}
+
 TEST_F(EvalCli, AnEmptyGroundTruthFileIsNotCalledMissing) {
   std::ofstream(dir_ / "seq" / "groundtruth.csv", std::ios::trunc).flush();
   std::string err;
