@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -310,6 +311,14 @@ int main(int argc, char** argv) {
     }
     if (out.empty()) return fail("--out is required to train (or use --evaluate / --apply; see --help)");
     if (train.seed == kHeldOutSceneSeed) return fail("--seed collides with the held-out data set's seed");
+    // --out must be writable before half an hour of rendering and training, and an existing file
+    // there (the shipped forest, say) stays as it is until the new one replaces it.
+    {
+      const bool existed = fs::exists(out);
+      const bool writable = std::ofstream(out, std::ios::binary | std::ios::app).good();
+      if (!existed) fs::remove(out);
+      if (!writable) return fail(out + ": cannot write");
+    }
 
     handtrack::tools::Progress progress(kProgram);
     const auto t0 = std::chrono::steady_clock::now();
