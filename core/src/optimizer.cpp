@@ -33,7 +33,10 @@ OptimizerResult AdaptiveGradientAscent::maximise(const PoseEnergy& energy, const
       previous[j] = agreement < 0.0 ? 0.0 : g;
       if (agreement >= 0.0 && g != 0.0) theta[j] += g > 0.0 ? step[j] : -step[j];
     }
-    const double e = energy.evaluate(frame, theta, scratch, &gradient);
+    // The last step's gradient would go unused: its energy alone (the same value, without the
+    // gradient's second pass over the pairs and the chain to Theta).
+    const bool last = it + 1 == iterations;
+    const double e = energy.evaluate(frame, theta, scratch, last ? nullptr : &gradient);
     if (e > best.energy && std::isfinite(e)) best = {theta, e};
   }
   return best;
