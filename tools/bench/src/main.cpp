@@ -13,6 +13,7 @@
 #include "handtrack/common/side_thread.hpp"
 #include "handtrack/synth/synthetic_camera.hpp"
 #include "handtrack/common/cli.hpp"
+#include "handtrack/tools/output_file.hpp"
 #include "handtrack/tools/progress.hpp"
 
 #include <nlohmann/json.hpp>
@@ -129,17 +130,11 @@ int main(int argc, char** argv) {
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
 
   try {
-    // The output files opened before anything is measured: a path that cannot be written is one
-    // error line at once, not after minutes of measuring.
-    const auto open_output = [](const std::string& path, std::ofstream& stream) {
-      if (path.empty()) return;
-      stream.open(path);
-      if (!stream) throw std::runtime_error(path + ": cannot write");
-    };
+    // The output files, opened before anything is measured.
     std::ofstream json_out;
     std::ofstream frames_out;
-    open_output(json_file, json_out);
-    open_output(frames_csv, frames_out);
+    tools::open_output(json_file, json_out);
+    tools::open_output(frames_csv, frames_out);
     const PartForest forest = PartForest::load(forest_file);
     CameraIntrinsics camera;
 

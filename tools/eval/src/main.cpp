@@ -13,6 +13,7 @@
 #include "handtrack/draw/plot.hpp"
 #include "handtrack/eval/scoring.hpp"
 #include "handtrack/common/cli.hpp"
+#include "handtrack/tools/output_file.hpp"
 #include "handtrack/tools/progress.hpp"
 #include "handtrack/tools/tracker_options.hpp"
 
@@ -410,26 +411,20 @@ int main(int argc, char** argv) {
       }
       total_frames += readers.back().frame_count();
     }
-    // Every output file opened (and refused with one line) before anything is tracked: a path
-    // that cannot be written must not cost a whole evaluation.
-    const auto open_output = [](const std::string& file, std::ofstream& out) {
-      if (file.empty()) return;
-      out.open(file);
-      if (!out) throw std::runtime_error(file + ": cannot write");
-    };
+    // Every output file opened (and refused with one line) before anything is tracked.
     std::ofstream tips_out;
     std::ofstream joints_out;
     for (const auto& [file, out, columns] : {std::tuple{&tips_file, &tips_out, PointColumns::fingertips()},
                                              std::tuple{&joints_file, &joints_out, PointColumns::joints()}}) {
-      open_output(*file, *out);
+      tools::open_output(*file, *out);
       if (out->is_open()) columns.write_header(*out);
     }
     std::ofstream json_out;
     std::ofstream csv_out;
     std::ofstream plot_out;  // held open until the PNG is written in its place
-    open_output(json_file, json_out);
-    open_output(csv_file, csv_out);
-    open_output(plot_file, plot_out);
+    tools::open_output(json_file, json_out);
+    tools::open_output(csv_file, csv_out);
+    tools::open_output(plot_file, plot_out);
     // --jobs: workers take the sequences in turn, each tracked from its first frame by a tracker of
     // its own, so every score is what one job gives; the results are gathered in the given order.
     std::vector<eval::SequenceScore> scores(readers.size());
