@@ -104,6 +104,22 @@ TEST_F(EvalCli, AnUnwritableOutputIsRefusedBeforeAnythingIsTracked) {
   }
 }
 
+// The outputs written at the end (JSON, per-frame CSV, plot) are checked at the start without being
+// created or emptied: a run that fails leaves the last run's files as they were, and no new ones.
+TEST_F(EvalCli, AFailedRunLeavesTheLastRunsOutputsAsTheyWere) {
+  const fs::path json = dir_ / "last.json";
+  std::ofstream(json) << "{\"last\": true}\n";
+  const fs::path csv = dir_ / "none.csv";
+  std::string err;
+  ASSERT_NE(eval(&err, "'" + (dir_ / "seq").string() + "' --json '" + json.string() + "' --csv '" + csv.string() + "'"),
+            0);
+  EXPECT_NE(err.find("no frame could be scored"), std::string::npos) << err;
+  std::ifstream in(json);
+  const std::string kept((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(kept, "{\"last\": true}\n");
+  EXPECT_FALSE(fs::exists(csv));
+}
+
 TEST_F(EvalCli, AnEmptyGroundTruthFileIsNotCalledMissing) {
   std::ofstream(dir_ / "seq" / "groundtruth.csv", std::ios::trunc).flush();
   std::string err;

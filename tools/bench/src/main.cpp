@@ -130,11 +130,8 @@ int main(int argc, char** argv) {
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
 
   try {
-    // The output files, opened before anything is measured.
-    std::ofstream json_out;
-    std::ofstream frames_out;
-    tools::open_output(json_file, json_out);
-    tools::open_output(frames_csv, frames_out);
+    tools::check_writable(json_file);
+    tools::check_writable(frames_csv);
     const PartForest forest = PartForest::load(forest_file);
     CameraIntrinsics camera;
 
@@ -280,7 +277,8 @@ int main(int argc, char** argv) {
       std::printf("%-48s %8.1f %14.2f %12.2f %9.2f/%.2f %8.2f%s\n", bc.name.c_str(), fps, pre, opt, p50, p99, overlap,
                   runs > 1 ? (" " + fps_list).c_str() : "");
     }
-    if (frames_out.is_open()) {
+    if (!frames_csv.empty()) {
+      std::ofstream frames_out(frames_csv);
       frames_out << "configuration,run,frame,preprocess_ms,optimize_ms,hands,iterations\n";
       for (size_t c = 0; c < chosen.size(); ++c) {
         for (size_t r = 0; r < runs_of[c].size(); ++r) {
@@ -293,7 +291,8 @@ int main(int argc, char** argv) {
       }
       if (!frames_out.flush()) throw std::runtime_error(frames_csv + ": cannot write");
     }
-    if (json_out.is_open()) {
+    if (!json_file.empty()) {
+      std::ofstream json_out(json_file);
       json_out << out.dump(2) << "\n";
       if (!json_out.flush()) throw std::runtime_error(json_file + ": cannot write");
     }

@@ -411,20 +411,18 @@ int main(int argc, char** argv) {
       }
       total_frames += readers.back().frame_count();
     }
-    // Every output file opened (and refused with one line) before anything is tracked.
+    // The point files opened, and the other outputs checked, before anything is tracked: a path
+    // that cannot be written is refused with one line.
     std::ofstream tips_out;
     std::ofstream joints_out;
     for (const auto& [file, out, columns] : {std::tuple{&tips_file, &tips_out, PointColumns::fingertips()},
                                              std::tuple{&joints_file, &joints_out, PointColumns::joints()}}) {
-      tools::open_output(*file, *out);
-      if (out->is_open()) columns.write_header(*out);
+      if (file->empty()) continue;
+      out->open(*file);
+      if (!*out) throw std::runtime_error(*file + ": cannot write");
+      columns.write_header(*out);
     }
-    std::ofstream json_out;
-    std::ofstream csv_out;
-    std::ofstream plot_out;  // held open until the PNG is written in its place
-    tools::open_output(json_file, json_out);
-    tools::open_output(csv_file, csv_out);
-    tools::open_output(plot_file, plot_out);
+    for (const std::string* file : {&json_file, &csv_file, &plot_file}) tools::check_writable(*file);
     // --jobs: workers take the sequences in turn, each tracked from its first frame by a tracker of
     // its own, so every score is what one job gives; the results are gathered in the given order.
     std::vector<eval::SequenceScore> scores(readers.size());
@@ -486,11 +484,13 @@ int main(int argc, char** argv) {
     }
     const auto groups = eval::group_scores(scores);
     const auto json = eval::to_json(scores, total, groups);
-    if (json_out.is_open()) {
+    if (!json_file.empty()) {
+      std::ofstream json_out(json_file);
       json_out << json.dump(2) << "\n";
       if (!json_out.flush()) throw std::runtime_error(json_file + ": cannot write");
     }
-    if (csv_out.is_open()) {
+    if (!csv_file.empty()) {
+      std::ofstream csv_out(csv_file);
       csv_out << "sequence,frame,error_mm\n";
       for (const auto& s : scores) {
         for (size_t i = 0; i < s.per_frame_error_mm.size(); ++i) {
@@ -499,8 +499,7 @@ int main(int argc, char** argv) {
       }
       if (!csv_out.flush()) throw std::runtime_error(csv_file + ": cannot write");
     }
-    if (plot_out.is_open()) {
-      plot_out.close();
+    if (!plot_file.empty()) {
       std::vector<draw::ErrorSeries> series;
       for (const auto& s : scores) series.push_back({s.name, s.per_frame_error_mm});
       draw::write_error_plot(plot_file, series);

@@ -8,6 +8,7 @@
 #include "handtrack/train_forest/forest_data.hpp"
 #include "handtrack/train_forest/trainer.hpp"
 #include "handtrack/common/cli.hpp"
+#include "handtrack/tools/output_file.hpp"
 #include "handtrack/tools/progress.hpp"
 
 #include <CLI/CLI.hpp>
@@ -17,7 +18,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -311,14 +311,9 @@ int main(int argc, char** argv) {
     }
     if (out.empty()) return fail("--out is required to train (or use --evaluate / --apply; see --help)");
     if (train.seed == kHeldOutSceneSeed) return fail("--seed collides with the held-out data set's seed");
-    // --out must be writable before half an hour of rendering and training, and an existing file
-    // there (the shipped forest, say) stays as it is until the new one replaces it.
-    {
-      const bool existed = fs::exists(out);
-      const bool writable = std::ofstream(out, std::ios::binary | std::ios::app).good();
-      if (!existed) fs::remove(out);
-      if (!writable) return fail(out + ": cannot write");
-    }
+    // Before half an hour of rendering and training; a forest already there (the shipped one, say)
+    // stays as it is until the new one replaces it.
+    handtrack::tools::check_writable(out);
 
     handtrack::tools::Progress progress(kProgram);
     const auto t0 = std::chrono::steady_clock::now();
