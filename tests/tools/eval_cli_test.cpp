@@ -91,9 +91,10 @@ TEST_F(EvalCli, NoScorableFrameIsAnErrorNotNan) {
   EXPECT_EQ(err.find("nan"), std::string::npos) << err;
 }
 
-// Every output file is opened before anything is tracked: an unwritable path is refused with one
-// line at once, not after an evaluation of many minutes (on the empty sequence the tracking would
-// end in "no frame could be scored", which came first while the outputs were opened at the end).
+// Every output file is checked (the point files opened) before anything is tracked: an unwritable
+// path is refused with one line at once, not after an evaluation of many minutes (on the empty
+// sequence the tracking would end in "no frame could be scored", which came first while the
+// outputs were opened only at the end).
 TEST_F(EvalCli, AnUnwritableOutputIsRefusedBeforeAnythingIsTracked) {
   const std::string seq = "'" + (dir_ / "seq").string() + "'";
   const std::string unwritable = (dir_ / "no-such-dir" / "out").string();
