@@ -7,9 +7,9 @@ namespace handtrack::daemon {
 
 static_assert(kMaxHands == 2, "run_slots() shares a frame's work between two hand slots");
 
-OptimizeStage::OptimizeStage(const TrackerConfig& config, TrackerReload& reload, RequestMailbox& request,
-                             StageWatch& watch, bool side, std::function<void()> side_setup)
-    : reload_(reload), request_(request), watch_(watch) {
+OptimizeStage::OptimizeStage(const TrackerConfig& config, CameraRoll roll, TrackerReload& reload,
+                             RequestMailbox& request, StageWatch& watch, bool side, std::function<void()> side_setup)
+    : reload_(reload), request_(request), watch_(watch), roll_(roll) {
   tracker_.emplace(config);
   request_.put(tracker_->request());  // the first frames: every hand slot free, up to max_hands
   fit_side_ = [this] { tracker_->fit(1, *side_inputs_); };
@@ -36,6 +36,7 @@ void OptimizeStage::step(Frame& f) {
     side_inputs_ = &f.inputs;
     run_slots(fitting, side_.get(), fit_side_, [&](int s) { tracker_->fit(s, f.inputs); });
     f.output = tracker_->finish();
+    turn_to_camera(roll_, &f.output);
   } else {
     tracker_->reset();
     f.output = HandsOutput{};

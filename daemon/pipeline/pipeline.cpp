@@ -20,6 +20,7 @@
 #include "handtrack/common/clock.hpp"
 #include "logging.hpp"
 
+#include <fmt/format.h>
 #include <pthread.h>
 
 #include <atomic>
@@ -289,6 +290,11 @@ bool Pipeline::start(std::string* why) {
                  "depth-only");
     }
   }
+  const std::optional<CameraRoll> roll = camera_roll_from_degrees(m.config.camera_roll_deg);
+  if (!roll) {
+    *why = fmt::format("camera.roll = {}: allowed: 0, 90, 180, 270 (or -90, -180)", m.config.camera_roll_deg);
+    return false;
+  }
   // The source starts after the forest is loaded: a recording plays in real time from its start.
   m.grab.emplace(m.config, *m.source, m.ring, m.tally, m.watch, m.grab_bell, m.recorder.get());
   if (!m.grab->start(why)) return false;
@@ -296,12 +302,12 @@ bool Pipeline::start(std::string* why) {
   m.reload.emplace(m.config.tracker);
   const PartForest* forest = m.forest ? &*m.forest : nullptr;
   // Each stage's side thread (the second hand) shares the other stage's CPU.
-  m.preprocess.emplace(m.config.tracker, *m.reload, m.request, forest, m.tally, m.watch, !m.config.single_thread,
+  m.preprocess.emplace(m.config.tracker, *roll, *m.reload, m.request, forest, m.tally, m.watch, !m.config.single_thread,
                        [&m] {
                          setup_pipeline_thread("ht-preprocess-2", m.config.pipeline.cpu[2], m.config.pipeline,
                                                StageRank::kPreprocess);
                        });
-  m.optimize.emplace(m.config.tracker, *m.reload, m.request, m.watch, !m.config.single_thread,
+  m.optimize.emplace(m.config.tracker, *roll, *m.reload, m.request, m.watch, !m.config.single_thread,
                      [&m] { setup_pipeline_thread("ht-optimize-2", m.config.pipeline.cpu[1], m.config.pipeline); });
   m.publish.emplace(m.ring, m.tally, m.watch, m.stats);
   m.allocate_pool();

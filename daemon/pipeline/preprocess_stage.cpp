@@ -9,11 +9,11 @@ namespace handtrack::daemon {
 
 static_assert(kMaxHands == 2, "run_slots() shares a frame's work between two hand slots");
 
-PreprocessStage::PreprocessStage(const TrackerConfig& config, TrackerReload& reload, const RequestMailbox& request,
-                                 const PartForest* forest, PipelineTally& tally, StageWatch& watch, bool side,
-                                 std::function<void()> side_setup)
+PreprocessStage::PreprocessStage(const TrackerConfig& config, CameraRoll roll, TrackerReload& reload,
+                                 const RequestMailbox& request, const PartForest* forest, PipelineTally& tally,
+                                 StageWatch& watch, bool side, std::function<void()> side_setup)
     : reload_(reload), request_(request), forest_(forest), tally_(tally), watch_(watch),
-      input_config_(input_config(config)) {
+      input_config_(input_config(config)), roll_(roll) {
   build_side_ = [this] { side_frame_->inputs.build_slot(1, side_frame_->depth, side_request_, forest_); };
   if (side) side_ = std::make_unique<SideThread>(std::move(side_setup));
 }
@@ -52,9 +52,12 @@ void PreprocessStage::step(Frame& f) {
       stream_width_ = cam.width;
       stream_height_ = cam.height;
     }
-    // Raw units to mm; pixels inside the working volume (Sec. 4: 150..600 mm).
-    const size_t in_volume = f.depth.assign_raw(cam, f.raw.depth_raw, static_cast<float>(input_config_.near_mm),
-                                                static_cast<float>(input_config_.far_mm));
+    // Raw units to mm; pixels inside the working volume (Sec. 4: 150..600 mm); upright.
+    DepthImage& mm = roll_ == CameraRoll::k0 ? f.depth : camera_depth_;
+    const size_t in_volume =
+        mm.assign_raw(cam, f.raw.depth_raw, static_cast<float>(input_config_.near_mm),
+                      static_cast<float>(input_config_.far_mm));
+    if (roll_ != CameraRoll::k0) turn_upright(camera_depth_, roll_, &f.depth);
     if (in_volume == 0) {
       f.empty = true;
     } else {

@@ -2,6 +2,7 @@
 // validation, --print-config and the docs, so a field cannot be parsed without being checked.
 #include "handtrack/daemon/config.hpp"
 
+#include "handtrack/core/camera_roll.hpp"
 #include "handtrack/core/hand_calibration.hpp"
 #include "handtrack/core/hands_tracker.hpp"
 
@@ -82,6 +83,10 @@ const std::vector<Field>& fields() {
      "preferred depth height", false},
     {"camera.fps", IntRef{[](DaemonConfig& c) -> int& { return c.source_options.fps; }}, 1, 1000,
      "preferred depth frame rate (the synthetic camera runs at it)", false},
+    {"camera.roll", IntRef{[](DaemonConfig& c) -> int& { return c.camera_roll_deg; }}, -180, 270,
+     "degrees the camera is mounted turned about its optical axis: 0, 90, 180 (upside down) or 270 (-90), as "
+     "handtrack-synth's --roll; frames are tracked turned upright, poses published in the camera's own frame",
+     false},
     // [synthetic]
     {"synthetic.frames", IntRef{[](DaemonConfig& c) -> int& { return c.source_options.synthetic_frames; }}, 2, 1000000,
      "frames in one pass of a synthetic motion (slow first half, fast second half)", false},
@@ -470,6 +475,9 @@ void validate(const DaemonConfig& config, const std::string& origin) {
           }
         },
         f.ref);
+  }
+  if (!camera_roll_from_degrees(c.camera_roll_deg)) {
+    throw_config_error(origin, fmt::format("camera.roll = {}: allowed: 0, 90, 180, 270 (or -90, -180)", c.camera_roll_deg));
   }
   if (c.shm_name.find('/') != std::string::npos) {
     throw_config_error(origin, fmt::format("daemon.shm_name = {}: allowed: a name without '/'", toml_quote(c.shm_name)));

@@ -75,6 +75,9 @@ TEST(DaemonConfig, BadValuesNameFileFieldAndRange) {
             "test.toml: tracker.particles must be an integer (allowed range 1..64)");
   EXPECT_EQ(error_of("[daemon]\nfast = 1\n"), "test.toml: daemon.fast must be true or false");
   EXPECT_EQ(error_of("[tracker]\narrangement = \"desk\"\n").find("test.toml: tracker.arrangement"), 0U);
+  EXPECT_EQ(error_of("[camera]\nroll = 45\n"), "test.toml: camera.roll = 45: allowed: 0, 90, 180, 270 (or -90, -180)");
+  EXPECT_EQ(error_of("[camera]\nroll = 360\n"),
+            "test.toml: camera.roll = 360 is out of range (allowed range -180..270)");
   EXPECT_EQ(error_of("[daemon]\nsource = \"\"\n"),
             "test.toml: daemon.source = '': allowed: a string of 1 to 4096 characters");
   EXPECT_NE(error_of("[nope]\nx = 1\n").find("unknown field 'nope.x'"), std::string::npos);

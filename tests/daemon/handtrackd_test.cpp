@@ -172,6 +172,34 @@ TEST_F(Handtrackd, SeqSourceFingertipsMatchGroundTruth) {
   EXPECT_EQ(cat_status(shm.str(), dir_).value("device_state", ""), "stopped");
 }
 
+// A camera mounted upside down (camera.roll = 180): the pinch rendered through a camera turned
+// half round, its ground truth in that camera's frame. The daemon tracks each frame turned upright
+// and publishes the poses turned back, so they meet the truth where the camera saw it (published in
+// the upright image's frame they would be hundreds of mm off: x and y negated).
+TEST_F(Handtrackd, ACameraMountedUpsideDownPublishesPosesInItsOwnFrame) {
+  const fs::path upside_down = dir_ / "pinch-upside-down";
+  const auto synth = run({kSynth, "--motion", "pinch", "--frames", "60", "--roll", "180", "--out", upside_down.string()},
+                         dir_, "synth", 120s);
+  ASSERT_EQ(synth.code, 0) << synth.err;
+  std::ofstream(dir_ / "roll.toml") << "[camera]\nroll = 180\n";
+  ShmName shm("roll");
+  Child cat({kCat, "--shm-name", shm.str(), "--count", "40", "--timeout", "30", "--from-start"}, dir_ / "cat.out",
+            dir_ / "cat.err");
+  const auto r = run(daemon_args({"--config", (dir_ / "roll.toml").string(), "--source", "seq:" + upside_down.string(),
+                                  "--fast", "--shm-name", shm.str()}),
+                     dir_, "daemon", 60s);
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_EQ(cat.wait(30s), 0) << cat.err();
+  const auto poses = parse_lines(cat.out());
+  ASSERT_EQ(poses.size(), 40U);
+  const SequenceReader truth(upside_down);
+  const double error = mean_fingertip_error(poses, [&](int frame) { return truth.fingertips(static_cast<size_t>(frame)); });
+  std::printf("camera upside down: mean fingertip error over %zu poses: %.1f mm\n", poses.size(), error);
+  EXPECT_LT(error, kMaxMeanFingertipErrorMm);
+  ASSERT_EQ(poses.back().at("hands").size(), 1U);
+  EXPECT_EQ(poses.back().at("hands")[0].at("handedness"), "right");
+}
+
 TEST_F(Handtrackd, SyntheticSourceFingertipsMatchGroundTruth) {
   ShmName shm("synthetic");
   Child cat({kCat, "--shm-name", shm.str(), "--count", "60", "--timeout", "30", "--from-start"}, dir_ / "cat.out",

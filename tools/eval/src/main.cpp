@@ -5,6 +5,7 @@
 // hand slots, docs/TRACKER.md "Two hands"). A sequence whose hand.json names two hands is scored
 // per hand (eval::HandsScorer, docs/SEQUENCES.md); a one-hand sequence with room for one hand,
 // unless --max-hands 2 asks for room for two there too (a second hand reported is a phantom).
+#include "handtrack/core/camera_roll.hpp"
 #include "handtrack/core/hand_calibration.hpp"
 #include "handtrack/core/hands_tracker.hpp"
 #include "handtrack/core/part_forest.hpp"
@@ -161,6 +162,7 @@ class SharedProgress {
 // What one worker's sequences share: the labeller (or the ground-truth labels behind
 // --oracle-labels), the --tips-csv rows of the sequence at hand and the progress over all frames.
 struct FrameLoop {
+  CameraRoll roll = CameraRoll::k0;               // --camera-roll
   const PixelLabeller* labeller = nullptr;
   std::vector<uint8_t>* oracle_labels = nullptr;  // non-null: filled with each frame's labels/
   std::ostream* tips = nullptr;                   // non-null: --tips-csv
@@ -173,10 +175,18 @@ struct FrameLoop {
   template <typename Track>
   void run_warm_up(Track&& track) const {
     if (warm_up == nullptr) return;
-    for (size_t i = 0; i < warm_up->frame_count(); ++i) track(warm_up->depth(i));
-    DepthImage empty = warm_up->depth(0);
+    for (size_t i = 0; i < warm_up->frame_count(); ++i) track(upright(warm_up->depth(i)));
+    DepthImage empty = upright(warm_up->depth(0));
     std::fill(empty.depth_mm.begin(), empty.depth_mm.end(), 0.0F);
     track(empty);
+  }
+
+  // --camera-roll: a frame as an upright camera would have taken it.
+  [[nodiscard]] DepthImage upright(DepthImage depth) const {
+    if (roll == CameraRoll::k0) return depth;
+    DepthImage turned;
+    turn_upright(depth, roll, &turned);
+    return turned;
   }
 
   // Tracks every frame of `reader` with track(depth) (timed) and hands its output to
@@ -185,11 +195,17 @@ struct FrameLoop {
   double run(const SequenceReader& reader, Track&& track, Score&& score) {
     double seconds = 0.0;
     for (size_t i = 0; i < reader.frame_count(); ++i) {
-      const DepthImage depth = reader.depth(i);
-      if (oracle_labels != nullptr) *oracle_labels = reader.labels(i).value_or(Gray8Image{}).pixels;
+      const DepthImage camera_depth = reader.depth(i);
+      const DepthImage depth = upright(camera_depth);
+      if (oracle_labels != nullptr) {
+        const std::optional<Gray8Image> labels = reader.labels(i);
+        oracle_labels->clear();  // a frame without labels/: none (FixedLabels then labels nothing)
+        if (labels) turn_upright(labels->pixels, camera_depth.camera, roll, oracle_labels);
+      }
       const auto t0 = std::chrono::steady_clock::now();
-      const auto out = track(depth);
+      auto out = track(depth);
       seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      turn_to_camera(roll, &out);  // scored in the camera's frame, where the truth is
       score(i, out);
       progress->frame_done(sequence_name(reader.dir()));
     }
@@ -359,6 +375,12 @@ int main(int argc, char** argv) {
   app.add_option("--far-mm", config.input.far_mm,
                  "far end of the working volume, mm (default 600, the paper's; hands farther away are not seen)")
       ->check(CLI::Range(1.0, 20000.0));
+  std::string camera_roll = "0";
+  app.add_option("--camera-roll", camera_roll,
+                 "degrees the camera is turned about its optical axis, as handtrack-synth's --roll: 0 (default), 90, "
+                 "180 (upside down) or 270 (-90); each frame is tracked turned upright and its poses scored turned "
+                 "back (handtrackd's camera.roll; docs/TRACKER.md, \"A camera mounted turned\")")
+      ->check([](const std::string& v) { return parse_camera_roll(v) ? "" : "one of 0, 90, 180, 270 (or -90, -180)"; });
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
   if (config.input.far_mm <= config.input.near_mm) {
     return report_error(kProgram, "--far-mm must be greater than --near-mm", 1);
@@ -438,6 +460,7 @@ int main(int argc, char** argv) {
       FrameLoop loop;
       loop.labeller = use_oracle_labels ? &oracle : forest ? static_cast<const PixelLabeller*>(&*forest) : nullptr;
       loop.oracle_labels = use_oracle_labels ? &truth_labels : nullptr;
+      loop.roll = *parse_camera_roll(camera_roll);  // one of the values the option's check let through
       loop.progress = &progress;
       loop.warm_up = warm_up_reader ? &*warm_up_reader : nullptr;
       for (size_t i = next_sequence++; i < readers.size(); i = next_sequence++) {

@@ -68,6 +68,9 @@ struct DaemonConfig {
   int64_t max_frames = 0;               // stop after this many frames (0 = never; tests)
   // [camera] (openni2 depth mode) and [synthetic]
   SourceOptions source_options;
+  // [camera]: degrees the camera is turned about its optical axis (camera_roll.hpp): 0, 90, 180,
+  // 270 (or -90, -180); each frame is tracked turned upright and its poses published turned back.
+  int camera_roll_deg = 0;
   // [pipeline]
   PipelineConfig pipeline;
   // [tracker], [tracker.input], [tracker.energy], [tracker.optimizer], [tracker.scale]
