@@ -175,18 +175,19 @@ struct FrameLoop {
   template <typename Track>
   void run_warm_up(Track&& track) const {
     if (warm_up == nullptr) return;
-    for (size_t i = 0; i < warm_up->frame_count(); ++i) track(upright(warm_up->depth(i)));
-    DepthImage empty = upright(warm_up->depth(0));
+    DepthImage turned;
+    for (size_t i = 0; i < warm_up->frame_count(); ++i) track(upright(warm_up->depth(i), &turned));
+    DepthImage empty = upright(warm_up->depth(0), &turned);
     std::fill(empty.depth_mm.begin(), empty.depth_mm.end(), 0.0F);
     track(empty);
   }
 
-  // --camera-roll: a frame as an upright camera would have taken it.
-  [[nodiscard]] DepthImage upright(DepthImage depth) const {
+  // --camera-roll: `depth` as an upright camera would have taken it (turned into *turned unless
+  // the camera is upright).
+  [[nodiscard]] const DepthImage& upright(const DepthImage& depth, DepthImage* turned) const {
     if (roll == CameraRoll::k0) return depth;
-    DepthImage turned;
-    turn_upright(depth, roll, &turned);
-    return turned;
+    turn_upright(depth, roll, turned);
+    return *turned;
   }
 
   // Tracks every frame of `reader` with track(depth) (timed) and hands its output to
@@ -194,9 +195,10 @@ struct FrameLoop {
   template <typename Track, typename Score>
   double run(const SequenceReader& reader, Track&& track, Score&& score) {
     double seconds = 0.0;
+    DepthImage turned;
     for (size_t i = 0; i < reader.frame_count(); ++i) {
       const DepthImage camera_depth = reader.depth(i);
-      const DepthImage depth = upright(camera_depth);
+      const DepthImage& depth = upright(camera_depth, &turned);
       if (oracle_labels != nullptr) {
         const std::optional<Gray8Image> labels = reader.labels(i);
         oracle_labels->clear();  // a frame without labels/: none (FixedLabels then labels nothing)
