@@ -1,8 +1,11 @@
 // The names of the tracker's modes and states, as the configuration and the outputs spell them
-// (tracker.hpp). Apart from the tracker, in handtrack::core_files: handtrackd's configuration
-// parser uses them, and the fuzz tree builds that parser without the tracker (tests/fuzz).
+// (tracker.hpp), and the camera's roll in degrees (camera_roll.hpp). Apart from the tracker, in
+// handtrack::core_files: handtrackd's configuration parser uses them, and the fuzz tree builds that
+// parser without the tracker (tests/fuzz).
+#include "handtrack/core/camera_roll.hpp"
 #include "handtrack/core/tracker.hpp"
 
+#include <charconv>
 #include <initializer_list>
 #include <string>
 
@@ -60,6 +63,38 @@ const char* to_string(CameraArrangement arrangement) {
 
 bool parse_camera_arrangement(const std::string& text, CameraArrangement* arrangement) {
   return parse_name(text, {CameraArrangement::kFacing, CameraArrangement::kHeadMounted}, arrangement);
+}
+
+std::optional<CameraRoll> parse_camera_roll(const std::string& degrees) {
+  int value = 0;
+  const char* end = degrees.data() + degrees.size();
+  const auto [rest, error] = std::from_chars(degrees.data(), end, value);
+  if (error != std::errc{} || rest != end) return std::nullopt;
+  return camera_roll_from_degrees(value);
+}
+
+std::optional<CameraRoll> camera_roll_from_degrees(int degrees) {
+  switch (degrees) {
+    case 0: return CameraRoll::k0;
+    case 90: return CameraRoll::k90;
+    case 180:
+    case -180: return CameraRoll::k180;
+    case 270:
+    case -90: return CameraRoll::k270;
+    default: return std::nullopt;
+  }
+}
+
+int degrees(CameraRoll roll) { return 90 * static_cast<int>(roll); }
+
+const char* forearm_edge(CameraRoll roll) {
+  switch (roll) {
+    case CameraRoll::k0: return "bottom";
+    case CameraRoll::k90: return "left";
+    case CameraRoll::k180: return "top";
+    case CameraRoll::k270: return "right";
+  }
+  return "bottom";
 }
 
 }  // namespace handtrack
