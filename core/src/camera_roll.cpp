@@ -1,6 +1,5 @@
 #include "handtrack/core/camera_roll.hpp"
 
-#include "handtrack/core/hand_layout.hpp"
 #include "handtrack/core/pose.hpp"
 
 #include <Eigen/Geometry>
@@ -111,35 +110,6 @@ void turn_to_camera(CameraRoll roll, TrackerOutput* output) {
 
 void turn_to_camera(CameraRoll roll, HandsOutput* output) {
   for (int i = 0; i < output->count; ++i) turn_to_camera(roll, &output->hands[static_cast<size_t>(i)]);
-}
-
-RollEstimator::RollEstimator(CameraRoll start) : roll_(start) { votes_[static_cast<size_t>(start)] = 1.0; }
-
-bool RollEstimator::observe(const HandsOutput& camera_hands) {
-  for (int i = 0; i < camera_hands.count; ++i) {
-    const TrackerOutput& hand = camera_hands.hands[static_cast<size_t>(i)];
-    if (hand.state != TrackingState::kTracking) continue;
-    const Eigen::Vector3d forearm =
-        hand.joints[kWristJoint] - hand.joints[static_cast<size_t>(joint_index(kMiddle, 0))];
-    const double x = forearm.x();
-    const double y = forearm.y();
-    if (!(x * x + y * y >= 0.25 * forearm.squaredNorm())) continue;  // along the optical axis (or NaN)
-    // The turn R_z(phi) that takes the upright forearm (0, 1) nearest to (x, y).
-    const CameraRoll vote = std::abs(y) >= std::abs(x) ? (y > 0.0 ? CameraRoll::k0 : CameraRoll::k180)
-                                                        : (x < 0.0 ? CameraRoll::k90 : CameraRoll::k270);
-    for (size_t r = 0; r < votes_.size(); ++r) {
-      votes_[r] = (1.0 - kRollVoteRate) * votes_[r] + (r == static_cast<size_t>(vote) ? kRollVoteRate : 0.0);
-    }
-    ++since_change_;
-  }
-  if (since_change_ < kRollVoteFrames) return false;
-  double total = 0.0;
-  for (const double v : votes_) total += v;
-  const auto best = static_cast<size_t>(std::max_element(votes_.begin(), votes_.end()) - votes_.begin());
-  if (best == static_cast<size_t>(roll_) || votes_[best] < kRollSwitchShare * total) return false;
-  roll_ = static_cast<CameraRoll>(best);
-  since_change_ = 0;
-  return true;
 }
 
 }  // namespace handtrack

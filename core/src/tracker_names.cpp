@@ -87,14 +87,4 @@ std::optional<CameraRoll> camera_roll_from_degrees(int degrees) {
 
 int degrees(CameraRoll roll) { return 90 * static_cast<int>(roll); }
 
-const char* forearm_edge(CameraRoll roll) {
-  switch (roll) {
-    case CameraRoll::k0: return "bottom";
-    case CameraRoll::k90: return "left";
-    case CameraRoll::k180: return "top";
-    case CameraRoll::k270: return "right";
-  }
-  return "bottom";
-}
-
 }  // namespace handtrack

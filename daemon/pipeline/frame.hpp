@@ -5,7 +5,6 @@
 //
 // Thread roles: a Frame belongs to exactly one stage at a time; handing its pointer through a
 // FrameQueue hands over the whole entry (the queue's push/pop order the accesses).
-#include "handtrack/core/camera_roll.hpp"
 #include "handtrack/core/depth_input.hpp"
 #include "handtrack/core/hands_tracker.hpp"
 #include "handtrack/daemon/depth_source.hpp"
@@ -20,7 +19,6 @@ struct Frame {
   RawFrame raw;
   DepthImage depth;                    // mm
   HandsInputs inputs;                  // per frame: frame t+1 is preprocessed while t is optimized
-  CameraRoll roll = CameraRoll::k0;    // `depth` and `inputs` are the camera's frame turned upright by it
   uint64_t inputs_generation = 0;      // the TrackerReload generation `inputs` was made for
   bool has_input = false;              // false: no depth in the working volume, or malformed
   bool empty = false;                  // nothing in the working volume: published as no_hand

@@ -7,12 +7,11 @@ namespace handtrack::daemon {
 
 static_assert(kMaxHands == 2, "run_slots() shares a frame's work between two hand slots");
 
-OptimizeStage::OptimizeStage(const TrackerConfig& config, CameraRoll roll, bool auto_roll, TrackerReload& reload,
+OptimizeStage::OptimizeStage(const TrackerConfig& config, CameraRoll roll, TrackerReload& reload,
                              RequestMailbox& request, StageWatch& watch, bool side, std::function<void()> side_setup)
-    : reload_(reload), request_(request), watch_(watch), fitted_roll_(roll) {
+    : reload_(reload), request_(request), watch_(watch), roll_(roll) {
   tracker_.emplace(config);
-  if (auto_roll) estimator_.emplace(roll);
-  request_.put({tracker_->request(), roll, roll});  // the first frames: every hand slot free, up to max_hands
+  request_.put(tracker_->request());  // the first frames: every hand slot free, up to max_hands
   fit_side_ = [this] { tracker_->fit(1, *side_inputs_); };
   if (side) side_ = std::make_unique<SideThread>(std::move(side_setup));
 }
@@ -32,27 +31,18 @@ void OptimizeStage::step(Frame& f) {
   watch_.busy(Stage::kOptimize, f.seq, f.optimize_start_ns);
   apply_reload();
   if (f.resolution_changed) tracker_->reset();
-  if (f.roll != fitted_roll_) {
-    tracker_->reset();
-    fitted_roll_ = f.roll;
-  }
   if (f.has_input) {
     const uint32_t fitting = tracker_->begin(f.inputs);
     side_inputs_ = &f.inputs;
     run_slots(fitting, side_.get(), fit_side_, [&](int s) { tracker_->fit(s, f.inputs); });
     f.output = tracker_->finish();
-    turn_to_camera(f.roll, &f.output);
-    if (estimator_ && estimator_->observe(f.output)) {
-      log().info("the hands' forearms keep entering from the image's {} edge: frames are turned by {} deg from now "
-                 "on (camera.auto_roll), tracking restarts",
-                 forearm_edge(estimator_->roll()), degrees(estimator_->roll()));
-    }
+    turn_to_camera(roll_, &f.output);
   } else {
     tracker_->reset();
     f.output = HandsOutput{};
   }
   // What the next frames need (per hand: which of left and right, the hints, the last pose).
-  request_.put({tracker_->request(), fitted_roll_, estimator_ ? estimator_->roll() : fitted_roll_});
+  request_.put(tracker_->request());
   f.optimize_end_ns = monotonic_ns();
   watch_.idle(Stage::kOptimize);
 }

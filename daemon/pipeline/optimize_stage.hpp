@@ -6,8 +6,7 @@
 // frame the second is optimized on a side thread while the optimize thread does the first, so the
 // two hands take about as long as one (issue 14; the paper's Sec. 7 runs stages on separate cores
 // the same way). The poses, fitted in the image turned upright for a camera mounted turned
-// (camera.roll), go out in the camera's own frame; with camera.auto_roll they vote on that roll,
-// and a frame turned by another roll than the last restarts the tracker. A frame with no depth, or the first of a new resolution, restarts the tracker. A
+// (camera.roll), go out in the camera's own frame. A frame with no depth, or the first of a new resolution, restarts the tracker. A
 // reloaded configuration (SIGHUP) rebuilds the tracker between two frames.
 //
 // Thread roles: thread-bound: step() from the optimize thread (or the single thread); the side
@@ -30,10 +29,9 @@ class OptimizeStage {
  public:
   // `side`: optimize a frame's second hand on a side thread (not in --single-thread mode, whose
   // point is one thread); `side_setup` runs first on that thread (name, CPU). `roll`: how the
-  // camera is mounted, the roll the first frames are turned upright by; `auto_roll`: moved by
-  // where the hands' forearms enter the image (RollEstimator).
-  OptimizeStage(const TrackerConfig& config, CameraRoll roll, bool auto_roll, TrackerReload& reload,
-                RequestMailbox& request, StageWatch& watch, bool side, std::function<void()> side_setup = {});
+  // camera is mounted (PreprocessStage turned its frames upright).
+  OptimizeStage(const TrackerConfig& config, CameraRoll roll, TrackerReload& reload, RequestMailbox& request,
+                StageWatch& watch, bool side, std::function<void()> side_setup = {});
 
   void step(Frame& frame);
 
@@ -43,8 +41,7 @@ class OptimizeStage {
   TrackerReload& reload_;
   RequestMailbox& request_;
   StageWatch& watch_;
-  CameraRoll fitted_roll_;  // the roll of the frames the tracker's poses are fitted in
-  std::optional<RollEstimator> estimator_;  // camera.auto_roll
+  CameraRoll roll_;
   std::optional<HandsTracker> tracker_;
   uint64_t tracker_generation_ = 0;
   // The side thread's job: fit slot 1 of the frame being optimized (set before post()).

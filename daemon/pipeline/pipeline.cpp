@@ -302,12 +302,12 @@ bool Pipeline::start(std::string* why) {
   m.reload.emplace(m.config.tracker);
   const PartForest* forest = m.forest ? &*m.forest : nullptr;
   // Each stage's side thread (the second hand) shares the other stage's CPU.
-  m.preprocess.emplace(m.config.tracker, *m.reload, m.request, forest, m.tally, m.watch, !m.config.single_thread,
+  m.preprocess.emplace(m.config.tracker, *roll, *m.reload, m.request, forest, m.tally, m.watch, !m.config.single_thread,
                        [&m] {
                          setup_pipeline_thread("ht-preprocess-2", m.config.pipeline.cpu[2], m.config.pipeline,
                                                StageRank::kPreprocess);
                        });
-  m.optimize.emplace(m.config.tracker, *roll, m.config.camera_auto_roll, *m.reload, m.request, m.watch, !m.config.single_thread,
+  m.optimize.emplace(m.config.tracker, *roll, *m.reload, m.request, m.watch, !m.config.single_thread,
                      [&m] { setup_pipeline_thread("ht-optimize-2", m.config.pipeline.cpu[1], m.config.pipeline); });
   m.publish.emplace(m.ring, m.tally, m.watch, m.stats);
   m.allocate_pool();

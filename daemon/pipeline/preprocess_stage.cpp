@@ -9,11 +9,11 @@ namespace handtrack::daemon {
 
 static_assert(kMaxHands == 2, "run_slots() shares a frame's work between two hand slots");
 
-PreprocessStage::PreprocessStage(const TrackerConfig& config, TrackerReload& reload, const RequestMailbox& request,
-                                 const PartForest* forest, PipelineTally& tally, StageWatch& watch, bool side,
-                                 std::function<void()> side_setup)
+PreprocessStage::PreprocessStage(const TrackerConfig& config, CameraRoll roll, TrackerReload& reload,
+                                 const RequestMailbox& request, const PartForest* forest, PipelineTally& tally,
+                                 StageWatch& watch, bool side, std::function<void()> side_setup)
     : reload_(reload), request_(request), forest_(forest), tally_(tally), watch_(watch),
-      input_config_(input_config(config)) {
+      input_config_(input_config(config)), roll_(roll) {
   build_side_ = [this] { side_frame_->inputs.build_slot(1, side_frame_->depth, side_request_, forest_); };
   if (side) side_ = std::make_unique<SideThread>(std::move(side_setup));
 }
@@ -37,8 +37,6 @@ void PreprocessStage::step(Frame& f) {
   f.empty = false;
   f.malformed = false;
   f.resolution_changed = false;
-  const NextFrames next = request_.get();
-  f.roll = next.roll;
   const CameraIntrinsics& cam = f.raw.camera;
   const auto n = static_cast<size_t>(std::max(cam.width, 0)) * static_cast<size_t>(std::max(cam.height, 0));
   if (n == 0 || f.raw.depth_raw.size() != n || !(cam.depth_scale_mm > 0.0)) {
@@ -55,19 +53,15 @@ void PreprocessStage::step(Frame& f) {
       stream_height_ = cam.height;
     }
     // Raw units to mm; pixels inside the working volume (Sec. 4: 150..600 mm); upright.
-    DepthImage& mm = f.roll == CameraRoll::k0 ? f.depth : camera_depth_;
+    DepthImage& mm = roll_ == CameraRoll::k0 ? f.depth : camera_depth_;
     const size_t in_volume =
         mm.assign_raw(cam, f.raw.depth_raw, static_cast<float>(input_config_.near_mm),
                       static_cast<float>(input_config_.far_mm));
-    if (f.roll != CameraRoll::k0) turn_upright(camera_depth_, f.roll, &f.depth);
+    if (roll_ != CameraRoll::k0) turn_upright(camera_depth_, roll_, &f.depth);
     if (in_volume == 0) {
       f.empty = true;
     } else {
-      side_request_ = next.request;
-      if (next.request_roll != f.roll) {  // the roll changed: no pose of the old one applies
-        side_request_ = HandsRequest{};
-        side_request_.max_hands = next.request.max_hands;
-      }
+      side_request_ = request_.get();
       const uint32_t slots = f.inputs.share(f.depth, side_request_);
       side_frame_ = &f;
       run_slots(slots, side_.get(), build_side_,

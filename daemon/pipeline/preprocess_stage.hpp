@@ -1,7 +1,6 @@
 #pragma once
 // PreprocessStage: raw depth -> C_I (paper Sec. 3.1, 4.3): depth to mm, the working-volume test,
-// the image turned upright for a camera mounted turned (camera.roll, camera_roll.hpp: the roll the
-// optimizer last asked for), then the frame's HandsInputs for the hands the tracker asked for (the frame shared out among
+// the image turned upright for a camera mounted turned (camera.roll, camera_roll.hpp), then the frame's HandsInputs for the hands the tracker asked for (the frame shared out among
 // the hands, median filter, segmentation guided by each last pose's hint, quadtree Gaussians, part labels when a forest is loaded). Frames whose buffer does not match
 // their intrinsics are marked malformed (skipped and counted at publish); frames with no depth in
 // the working volume are marked empty (published as no_hand). The first frame of a new resolution
@@ -31,7 +30,8 @@ class PreprocessStage {
   // `forest` may be null (depth-only); it outlives the stage.
   // `side`: build a frame's second hand on a side thread (not in --single-thread mode);
   // `side_setup` runs first on that thread (name, CPU).
-  PreprocessStage(const TrackerConfig& config, TrackerReload& reload, const RequestMailbox& request,
+  // `roll`: how the camera is mounted; the frames' depth is turned upright.
+  PreprocessStage(const TrackerConfig& config, CameraRoll roll, TrackerReload& reload, const RequestMailbox& request,
                   const PartForest* forest, PipelineTally& tally, StageWatch& watch, bool side = false,
                   std::function<void()> side_setup = {});
 
@@ -49,6 +49,7 @@ class PreprocessStage {
   PipelineTally& tally_;
   StageWatch& watch_;
   DepthInputConfig input_config_;
+  CameraRoll roll_;
   DepthImage camera_depth_;  // a turned camera's frame in mm, before it is turned upright
   FrameSplitter splitter_;  // every pool frame's: only step() shares a frame out
   uint64_t input_generation_ = 0;

@@ -4,7 +4,6 @@
 // optimize).
 //
 // Thread roles: thread-safe (a mutex each; taken once per frame, never contended for long).
-#include "handtrack/core/camera_roll.hpp"
 #include "handtrack/core/hands_tracker.hpp"
 
 #include <atomic>
@@ -14,35 +13,24 @@
 
 namespace handtrack::daemon {
 
-// What the optimizer asks of the next frames' preprocessing: the tracker's request
-// (HandsTracker::request(): per hand which of left and right, the segmentation hints and the last
-// pose, by which the frame is shared out among the hands) and how to turn the frames upright
-// (camera.roll; camera.auto_roll moves it). The request's poses are in the upright image of the
-// roll their frame was turned by: a frame turned otherwise gets a fresh request (the tracker
-// restarts on it).
-struct NextFrames {
-  HandsRequest request;
-  CameraRoll request_roll = CameraRoll::k0;  // the roll of the frame the request's poses were fitted in
-  CameraRoll roll = CameraRoll::k0;          // the roll to turn the next frames by
-};
-
-// Optimize writes after every frame, preprocess reads before every frame. A frame preprocessed
-// while the previous one is still being optimized uses the request of the one before: that lag of
-// one frame is the price of the overlap.
+// The tracker's request for the next frame (HandsTracker::request(): per hand which of left and
+// right, the segmentation hints and the last pose, by which the frame is shared out among the hands): optimize writes after every frame, preprocess reads before
+// every frame. A frame preprocessed while the previous one is still being optimized uses the
+// request of the one before: that lag of one frame is the price of the overlap.
 class RequestMailbox {
  public:
-  void put(const NextFrames& next) {
+  void put(const HandsRequest& request) {
     std::lock_guard lock(mutex_);
-    next_ = next;
+    request_ = request;
   }
-  [[nodiscard]] NextFrames get() const {
+  [[nodiscard]] HandsRequest get() const {
     std::lock_guard lock(mutex_);
-    return next_;
+    return request_;
   }
 
  private:
   mutable std::mutex mutex_;
-  NextFrames next_;
+  HandsRequest request_;
 };
 
 // SIGHUP: the control thread posts a new tracker configuration; each stage that depends on it

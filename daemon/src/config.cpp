@@ -87,10 +87,6 @@ const std::vector<Field>& fields() {
      "degrees the camera is mounted turned about its optical axis: 0, 90, 180 (upside down) or 270 (-90), as "
      "handtrack-synth's --roll; frames are tracked turned upright, poses published in the camera's own frame",
      false},
-    {"camera.auto_roll", BoolRef{[](DaemonConfig& c) -> bool& { return c.camera_auto_roll; }}, 0, 0,
-     "true: the roll follows the hands, starting from camera.roll: when the tracked forearms keep entering from "
-     "another image edge, the frames are turned so that they enter from the bottom, and tracking restarts",
-     false},
     // [synthetic]
     {"synthetic.frames", IntRef{[](DaemonConfig& c) -> int& { return c.source_options.synthetic_frames; }}, 2, 1000000,
      "frames in one pass of a synthetic motion (slow first half, fast second half)", false},

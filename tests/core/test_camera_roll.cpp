@@ -1,7 +1,6 @@
 // A camera mounted turned (camera_roll.hpp): the image turned upright is the same scene, and a pose
 // tracked in it turns back into the camera's frame with its parameters.
 #include "handtrack/core/camera_roll.hpp"
-#include "handtrack/core/hand_layout.hpp"
 #include "handtrack/core/hand_model.hpp"
 #include "handtrack/core/kinematics.hpp"
 
@@ -101,65 +100,6 @@ TEST(CameraRoll, APoseTurnsBackWithItsParameters) {
       EXPECT_LT((out.palm_normal - turn_to_camera(roll, upright.palm_normal)).norm(), 1e-12);
     }
   }
-}
-
-// One tracked hand whose forearm (knuckle of the middle finger to the wrist) points along `forearm`
-// in the camera's frame.
-HandsOutput hand_with_forearm(const Eigen::Vector3d& forearm) {
-  HandsOutput out;
-  out.count = 1;
-  TrackerOutput& hand = out.hands[0];
-  hand.state = TrackingState::kTracking;
-  hand.joints[static_cast<size_t>(joint_index(kMiddle, 0))] = Eigen::Vector3d(0.0, 0.0, 400.0);
-  hand.joints[kWristJoint] = Eigen::Vector3d(0.0, 0.0, 400.0) + 90.0 * forearm.normalized();
-  return out;
-}
-
-// The frame on which RollEstimator first reports a change, or -1 within `frames`.
-int first_change(RollEstimator& estimator, const HandsOutput& hands, int frames) {
-  for (int i = 0; i < frames; ++i) {
-    if (estimator.observe(hands)) return i;
-  }
-  return -1;
-}
-
-TEST(RollEstimator, TurnsTheImageOnlyWhenTheForearmsKeepEnteringFromAnotherEdge) {
-  // Upright forearms (+y, from the image's bottom) never turn it.
-  RollEstimator upright;
-  EXPECT_EQ(first_change(upright, hand_with_forearm({0.2, 1.0, 0.3}), 1000), -1);
-  EXPECT_EQ(upright.roll(), CameraRoll::k0);
-  // From the top (a camera upside down): 180 deg, once the votes reach 3/4 (124 frames from the
-  // prior), and then the roll holds.
-  RollEstimator turned;
-  EXPECT_EQ(first_change(turned, hand_with_forearm({0.1, -1.0, 0.0}), 1000), 124);
-  EXPECT_EQ(turned.roll(), CameraRoll::k180);
-  EXPECT_EQ(first_change(turned, hand_with_forearm({0.1, -1.0, 0.0}), 1000), -1);
-  // From the left and the right: the turns handtrack-synth's --roll 90 and -90 give the upright forearm.
-  RollEstimator left;
-  first_change(left, hand_with_forearm({-1.0, 0.0, 0.0}), 200);
-  EXPECT_EQ(left.roll(), CameraRoll::k90);
-  RollEstimator right;
-  first_change(right, hand_with_forearm({1.0, 0.0, 0.0}), 200);
-  EXPECT_EQ(right.roll(), CameraRoll::k270);
-  // Back to upright after a change: not before kRollVoteFrames hand-frames.
-  RollEstimator back(CameraRoll::k180);
-  const int frames = first_change(back, hand_with_forearm({0.0, 1.0, 0.0}), 1000);
-  EXPECT_GE(frames, kRollVoteFrames - 1);
-  EXPECT_EQ(back.roll(), CameraRoll::k0);
-}
-
-TEST(RollEstimator, HandsThatCannotTellDoNotVote) {
-  RollEstimator estimator;
-  // Along the optical axis (fingers toward the camera), recovering, or no hand.
-  EXPECT_EQ(first_change(estimator, hand_with_forearm({0.0, -0.3, 1.0}), 1000), -1);
-  HandsOutput recovering = hand_with_forearm({0.0, -1.0, 0.0});
-  recovering.hands[0].state = TrackingState::kRecovering;
-  EXPECT_EQ(first_change(estimator, recovering, 1000), -1);
-  EXPECT_EQ(first_change(estimator, HandsOutput{}, 1000), -1);
-  // A hand that passes through pointing down for a second (60 frames) between upright ones.
-  EXPECT_EQ(first_change(estimator, hand_with_forearm({0.0, -1.0, 0.0}), 60), -1);
-  EXPECT_EQ(first_change(estimator, hand_with_forearm({0.0, 1.0, 0.0}), 300), -1);
-  EXPECT_EQ(estimator.roll(), CameraRoll::k0);
 }
 
 }  // namespace

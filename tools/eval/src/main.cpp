@@ -162,8 +162,7 @@ class SharedProgress {
 // What one worker's sequences share: the labeller (or the ground-truth labels behind
 // --oracle-labels), the --tips-csv rows of the sequence at hand and the progress over all frames.
 struct FrameLoop {
-  CameraRoll roll = CameraRoll::k0;               // --camera-roll (with --auto-roll, the first)
-  bool auto_roll = false;                         // --auto-roll
+  CameraRoll roll = CameraRoll::k0;               // --camera-roll
   const PixelLabeller* labeller = nullptr;
   std::vector<uint8_t>* oracle_labels = nullptr;  // non-null: filled with each frame's labels/
   std::ostream* tips = nullptr;                   // non-null: --tips-csv
@@ -171,62 +170,45 @@ struct FrameLoop {
   SharedProgress* progress = nullptr;
   const SequenceReader* warm_up = nullptr;        // non-null: --warm-up
 
-  // How one sequence (with its warm-up) is seen: the roll its frames are turned upright by, which
-  // with --auto-roll the hands move as handtrackd's camera.auto_roll does.
-  struct Mount {
-    CameraRoll roll;
-    std::optional<RollEstimator> estimator;
-    DepthImage turned;
-  };
-  [[nodiscard]] Mount mount() const {
-    Mount m{roll, std::nullopt, {}};
-    if (auto_roll) m.estimator.emplace(roll);
-    return m;
-  }
-
-  // One frame: turned upright, tracked, its hands turned back into the camera's frame (where the
-  // truth is); with --auto-roll they vote on the roll, and a change restarts the tracker.
-  HandsOutput track(Mount& m, HandsTracker& tracker, const DepthImage& camera_depth) const {
+  // One frame: turned upright (--camera-roll; into *turned), tracked, its hands turned back into
+  // the camera's frame, where the truth is.
+  HandsOutput track(HandsTracker& tracker, const DepthImage& camera_depth, DepthImage* turned) const {
     const DepthImage* depth = &camera_depth;
-    if (m.roll != CameraRoll::k0) {
-      turn_upright(camera_depth, m.roll, &m.turned);
-      depth = &m.turned;
+    if (roll != CameraRoll::k0) {
+      turn_upright(camera_depth, roll, turned);
+      depth = turned;
     }
     HandsOutput out = tracker.track(*depth, labeller);
-    turn_to_camera(m.roll, &out);
-    if (m.estimator && m.estimator->observe(out)) {
-      m.roll = m.estimator->roll();
-      tracker.reset();
-    }
+    turn_to_camera(roll, &out);
     return out;
   }
 
   // --warm-up: every frame of that sequence tracked first, unscored, then one frame without a hand
   // (the hand has left), so that the scored sequence is a hand seen again in a session.
-  void run_warm_up(Mount& m, HandsTracker& tracker) const {
+  void run_warm_up(HandsTracker& tracker, DepthImage* turned) const {
     if (warm_up == nullptr) return;
-    for (size_t i = 0; i < warm_up->frame_count(); ++i) track(m, tracker, warm_up->depth(i));
+    for (size_t i = 0; i < warm_up->frame_count(); ++i) track(tracker, warm_up->depth(i), turned);
     DepthImage empty = warm_up->depth(0);
     std::fill(empty.depth_mm.begin(), empty.depth_mm.end(), 0.0F);
-    track(m, tracker, empty);
+    track(tracker, empty, turned);
   }
 
   // Tracks every frame of `reader` (its warm-up first) and hands its output to score(i, output);
   // returns the seconds spent tracking.
   template <typename Score>
   double run(const SequenceReader& reader, HandsTracker& tracker, Score&& score) {
-    Mount m = mount();
-    run_warm_up(m, tracker);
+    DepthImage turned;
+    run_warm_up(tracker, &turned);
     double seconds = 0.0;
     for (size_t i = 0; i < reader.frame_count(); ++i) {
       const DepthImage camera_depth = reader.depth(i);
       if (oracle_labels != nullptr) {
         const std::optional<Gray8Image> labels = reader.labels(i);
         oracle_labels->clear();  // a frame without labels/: none (FixedLabels then labels nothing)
-        if (labels) turn_upright(labels->pixels, camera_depth.camera, m.roll, oracle_labels);
+        if (labels) turn_upright(labels->pixels, camera_depth.camera, roll, oracle_labels);
       }
       const auto t0 = std::chrono::steady_clock::now();
-      const HandsOutput out = track(m, tracker, camera_depth);
+      const HandsOutput out = track(tracker, camera_depth, &turned);
       seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       score(i, out);
       progress->frame_done(sequence_name(reader.dir()));
@@ -397,11 +379,6 @@ int main(int argc, char** argv) {
                  "180 (upside down) or 270 (-90); each frame is tracked turned upright and its poses scored turned "
                  "back (handtrackd's camera.roll; docs/TRACKER.md, \"A camera mounted turned\")")
       ->check([](const std::string& v) { return parse_camera_roll(v) ? "" : "one of 0, 90, 180, 270 (or -90, -180)"; });
-  bool auto_roll = false;
-  app.add_flag("--auto-roll", auto_roll,
-               "the camera's roll found from the hands, as handtrackd's camera.auto_roll: when the tracked "
-               "forearms keep entering from another image edge the frames are turned so that they enter from the "
-               "bottom and the tracker restarts (--camera-roll: the roll to start from)");
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
   if (config.input.far_mm <= config.input.near_mm) {
     return report_error(kProgram, "--far-mm must be greater than --near-mm", 1);
@@ -482,7 +459,6 @@ int main(int argc, char** argv) {
       loop.labeller = use_oracle_labels ? &oracle : forest ? static_cast<const PixelLabeller*>(&*forest) : nullptr;
       loop.oracle_labels = use_oracle_labels ? &truth_labels : nullptr;
       loop.roll = *parse_camera_roll(camera_roll);  // one of the values the option's check let through
-      loop.auto_roll = auto_roll;
       loop.progress = &progress;
       loop.warm_up = warm_up_reader ? &*warm_up_reader : nullptr;
       for (size_t i = next_sequence++; i < readers.size(); i = next_sequence++) {

@@ -25,7 +25,6 @@
 #include "handtrack/core/camera.hpp"
 #include "handtrack/core/hands_tracker.hpp"
 
-#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -59,37 +58,5 @@ Eigen::Vector3d turn_to_camera(CameraRoll roll, const Eigen::Vector3d& upright_p
 // and normal, and the wrist position and global rotation of its parameters.
 void turn_to_camera(CameraRoll roll, TrackerOutput* output);
 void turn_to_camera(CameraRoll roll, HandsOutput* output);
-
-// The roll found from the hands themselves (camera.auto_roll): a user's forearm enters the image
-// from the edge nearest the user, frame after frame, and an upright camera has it at the bottom.
-// Each hand tracked (not recovering) votes for the roll that would bring its forearm there: the
-// direction from its middle finger's knuckle to its wrist in the camera's own frame, x and y only,
-// nearest to down (+y: 0 deg), left (-x: 90), up (-y: 180) or right (+x: 270), the turn R_z(phi)
-// gives the upright forearm (0, 1). A hand that points along the optical axis (its forearm less
-// than half in the image plane) does not vote. The votes decay exponentially, at
-// kRollVoteRate per hand-frame, from a prior of 1 on the starting roll; the roll changes to one
-// whose votes reach kRollSwitchShare of the whole, and not again for kRollVoteFrames hand-frames,
-// so a hand held pointing down for a few seconds turns the image (the forest then reads it
-// upright), but a hand that passes through does not. Each change restarts the tracking.
-inline constexpr double kRollVoteRate = 1.0 / 90.0;
-inline constexpr double kRollSwitchShare = 0.75;
-inline constexpr int kRollVoteFrames = 90;
-
-class RollEstimator {
- public:
-  explicit RollEstimator(CameraRoll start = CameraRoll::k0);
-  // One frame's hands in the camera's own frame (turned back); true when the roll changes.
-  bool observe(const HandsOutput& camera_hands);
-  [[nodiscard]] CameraRoll roll() const { return roll_; }
-
- private:
-  std::array<double, 4> votes_{};  // per roll, 0 / 90 / 180 / 270
-  CameraRoll roll_;
-  int since_change_ = 0;
-};
-
-// The image edge the forearm of a camera turned by `roll` enters from, for messages: "bottom",
-// "left", "top", "right".
-const char* forearm_edge(CameraRoll roll);
 
 }  // namespace handtrack

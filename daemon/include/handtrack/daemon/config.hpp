@@ -71,8 +71,6 @@ struct DaemonConfig {
   // [camera]: degrees the camera is turned about its optical axis (camera_roll.hpp): 0, 90, 180,
   // 270 (or -90, -180); each frame is tracked turned upright and its poses published turned back.
   int camera_roll_deg = 0;
-  // [camera]: the roll found from the hands (RollEstimator), starting from camera_roll_deg.
-  bool camera_auto_roll = false;
   // [pipeline]
   PipelineConfig pipeline;
   // [tracker], [tracker.input], [tracker.energy], [tracker.optimizer], [tracker.scale]
