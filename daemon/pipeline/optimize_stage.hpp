@@ -6,8 +6,9 @@
 // frame the second is optimized on a side thread while the optimize thread does the first, so the
 // two hands take about as long as one (issue 14; the paper's Sec. 7 runs stages on separate cores
 // the same way). The poses, fitted in the image turned upright for a camera mounted turned
-// (camera.roll), go out in the camera's own frame. A frame with no depth, or the first of a new resolution, restarts the tracker. A
-// reloaded configuration (SIGHUP) rebuilds the tracker between two frames.
+// (camera.roll), go out in the camera's own frame. A frame with no depth, or the first of a new
+// resolution, restarts the tracker. A reloaded configuration (SIGHUP) rebuilds the tracker between
+// two frames.
 //
 // Thread roles: thread-bound: step() from the optimize thread (or the single thread); the side
 // thread runs only HandsTracker::fit() of the second hand, between post() and wait() in step().

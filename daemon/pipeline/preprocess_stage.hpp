@@ -1,10 +1,12 @@
 #pragma once
 // PreprocessStage: raw depth -> C_I (paper Sec. 3.1, 4.3): depth to mm, the working-volume test,
-// the image turned upright for a camera mounted turned (camera.roll, camera_roll.hpp), then the frame's HandsInputs for the hands the tracker asked for (the frame shared out among
-// the hands, median filter, segmentation guided by each last pose's hint, quadtree Gaussians, part labels when a forest is loaded). Frames whose buffer does not match
-// their intrinsics are marked malformed (skipped and counted at publish); frames with no depth in
-// the working volume are marked empty (published as no_hand). The first frame of a new resolution
-// is marked so that the optimizer restarts.
+// the image turned upright for a camera mounted turned (camera.roll, camera_roll.hpp), then the
+// frame's HandsInputs for the hands the tracker asked for (the frame shared out among the hands,
+// median filter, segmentation guided by each last pose's hint, quadtree Gaussians, part labels
+// when a forest is loaded). Frames whose buffer does not match their intrinsics are marked
+// malformed (skipped and counted at publish); frames with no depth in the working volume are marked
+// empty (published as no_hand). The first frame of a new resolution is marked so that the
+// optimizer restarts.
 //
 // With two hands in a frame the second hand's input is built on a side thread while the preprocess
 // thread builds the first's (the forest's labels are most of the work; PartForest is thread-safe).
