@@ -3,7 +3,8 @@
 // behind the hand) and eight poses per frame near and off the true pose (energy_cases.hpp).
 //
 //   preprocessing   DepthInputBuilder::build without and with the part forest, the forest alone,
-//                   E_free's map and E_unseen's weights of a frame, the palm's hollow of a fit
+//                   E_free's map and E_unseen's weights of a frame, the palm's hollow of a fit,
+//                   a frame turned upright (camera.roll)
 //   E_sim           energy + gradient per factor, the optimised term and the plain reference
 //   E               PoseEnergy::evaluate (posing the model, every term, the chain rule)
 //   E_hand          the two-hand collision term alone, and E with another hand touching or apart
@@ -14,6 +15,7 @@
 #include "energy_cases.hpp"
 #include "reference_energy.hpp"
 
+#include "handtrack/core/camera_roll.hpp"
 #include "handtrack/core/energy.hpp"
 #include "handtrack/core/free_space.hpp"
 #include "handtrack/core/optimizer.hpp"
@@ -126,6 +128,20 @@ void BM_FreeSpaceMap(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_FreeSpaceMap)->Unit(benchmark::kMicrosecond);
+
+// A camera mounted turned (camera_roll.hpp): one frame's depth in mm turned upright, at 90 and 180
+// deg (270 is 90's loop with the other axis reversed). Added to preprocessing when camera.roll is set.
+void BM_TurnUpright(benchmark::State& state) {
+  const CameraRoll roll = state.range(0) == 90 ? CameraRoll::k90 : CameraRoll::k180;
+  DepthImage upright;
+  size_t i = 0;
+  for (auto _ : state) {
+    turn_upright(cases()[i].frame.depth, roll, &upright);
+    benchmark::DoNotOptimize(upright.depth_mm.data());
+    i = (i + 1) % cases().size();
+  }
+}
+BENCHMARK(BM_TurnUpright)->ArgName("roll")->Arg(90)->Arg(180)->Unit(benchmark::kMicrosecond);
 
 // E_unseen's weights of one frame (unseen_fingers.hpp): the label histogram of the whole image
 // (the frames' ground-truth labels) and the previous pose's rotation, once a frame while late
