@@ -86,6 +86,10 @@ Eigen::Vector3d turn_to_camera(CameraRoll roll, const Eigen::Vector3d& p) {
   return p;
 }
 
+Eigen::Vector3d turn_to_upright(CameraRoll roll, const Eigen::Vector3d& p) {
+  return turn_to_camera(static_cast<CameraRoll>((4 - static_cast<int>(roll)) % 4), p);
+}
+
 void turn_to_camera(CameraRoll roll, TrackerOutput* output) {
   if (roll == CameraRoll::k0) return;
   for (auto& j : output->joints) j = turn_to_camera(roll, j);

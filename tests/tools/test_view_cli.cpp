@@ -203,6 +203,22 @@ TEST_F(ViewCli, RendersATrackedSequenceFrameWithLabels) {
   EXPECT_LT(size->height, cam.height + 100);
 }
 
+// --camera-roll: the frame is drawn as the tracker sees it, turned upright. A quarter turn makes the
+// 320x240 image 240 wide and 320 high, so each panel is too (and its caption a line longer).
+TEST_F(ViewCli, ACameraTurnedIsDrawnUpright) {
+  const fs::path seq = make_sequence(6);
+  const fs::path out = dir_ / "turned.png";
+  const ProcessResult r = view("--seq '" + seq.string() + "' --frame 5 --camera-roll 90 --out '" + out.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto size = read_png_size(out);
+  ASSERT_TRUE(size) << "not a valid PNG: " << out;
+  const CameraIntrinsics cam = SequenceReader(seq).camera();
+  EXPECT_GE(size->width, 4 * cam.height);
+  EXPECT_LT(size->width, 4 * cam.width);
+  EXPECT_GT(size->height, cam.width);
+  EXPECT_LT(size->height, cam.width + 120);
+}
+
 TEST_F(ViewCli, EveryKthFrameOfASequence) {
   const fs::path seq = make_sequence(5);
   const ProcessResult r = view("--seq '" + seq.string() + "' --every 2 --crop --out '" + (dir_ / "out.png").string() + "'");
@@ -304,7 +320,8 @@ TEST_F(ViewCli, FrameOutOfRangeFailsCleanly) {
 
 TEST_F(ViewCli, UsageErrorsAreOneLine) {
   for (const std::string args : {"", "--out x.png", "--seq a --depth b --out x.png", "--frame -3 --out x.png",
-                                 "--bogus", "--arrangement sideways --out x.png", "--hand both --out x.png"}) {
+                                 "--bogus", "--arrangement sideways --out x.png", "--hand both --out x.png",
+                                 "--camera-roll 45 --out x.png"}) {
     const ProcessResult r = view(args);
     EXPECT_NE(r.exit_code, 0) << args;
     EXPECT_NE(r.exit_code, 1) << args << ": usage errors are not input errors";

@@ -374,11 +374,7 @@ int main(int argc, char** argv) {
                  "far end of the working volume, mm (default 600, the paper's; hands farther away are not seen)")
       ->check(CLI::Range(1.0, 20000.0));
   std::string camera_roll = "0";
-  app.add_option("--camera-roll", camera_roll,
-                 "degrees the camera is turned about its optical axis, as handtrack-synth's --roll: 0 (default), 90, "
-                 "180 (upside down) or 270 (-90); each frame is tracked turned upright and its poses scored turned "
-                 "back (handtrackd's camera.roll; docs/TRACKER.md, \"A camera mounted turned\")")
-      ->check([](const std::string& v) { return parse_camera_roll(v) ? "" : "one of 0, 90, 180, 270 (or -90, -180)"; });
+  tools::add_camera_roll_option(app, camera_roll, " and its poses scored turned back");
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
   if (config.input.far_mm <= config.input.near_mm) {
     return report_error(kProgram, "--far-mm must be greater than --near-mm", 1);

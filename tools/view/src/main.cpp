@@ -58,6 +58,38 @@ struct Args {
   std::string arrangement = "facing";
   std::string hand = "auto";
   std::string forest;
+  std::string camera_roll = "0";
+};
+
+// --camera-roll: the frame, its labels and its true fingertips as the tracker sees them, turned
+// upright (what the panels show; the poses stay in that image's frame).
+struct Upright {
+  handtrack::CameraRoll roll = handtrack::CameraRoll::k0;
+  handtrack::DepthImage depth;
+
+  const handtrack::DepthImage& frame(const handtrack::DepthImage& camera_depth) {
+    if (roll == handtrack::CameraRoll::k0) return camera_depth;
+    handtrack::turn_upright(camera_depth, roll, &depth);
+    return depth;
+  }
+  [[nodiscard]] handtrack::Gray8Image labels(const handtrack::Gray8Image& camera_labels,
+                                            const handtrack::CameraIntrinsics& camera) const {
+    handtrack::Gray8Image out;
+    const handtrack::CameraIntrinsics upright = handtrack::upright_camera(camera, roll);
+    out.width = upright.width;
+    out.height = upright.height;
+    handtrack::turn_upright(camera_labels.pixels, camera, roll, &out.pixels);
+    return out;
+  }
+  [[nodiscard]] handtrack::Fingertips tips(handtrack::Fingertips camera_tips) const {
+    for (auto& t : camera_tips) {
+      if (t) t = handtrack::turn_to_upright(roll, *t);
+    }
+    return camera_tips;
+  }
+  [[nodiscard]] std::string caption() const {
+    return roll == handtrack::CameraRoll::k0 ? "" : "\nturned upright: roll " + std::to_string(degrees(roll));
+  }
 };
 
 handtrack::TrackerConfig tracker_config(const Args& a) {
@@ -146,13 +178,16 @@ int run_sequence(const Args& a) {
   const auto forest = load_forest(a);
   Progress progress(last + 1);
   int written = 0;
+  Upright upright{*handtrack::parse_camera_roll(a.camera_roll), {}};
   for (size_t i = 0; i <= last; ++i) {
-    const handtrack::DepthImage depth = reader.depth(i);
+    const handtrack::DepthImage camera_depth = reader.depth(i);
+    const handtrack::DepthImage& depth = upright.frame(camera_depth);
     const handtrack::HandsOutput output = tracker.track(depth, labeller(forest));
     progress.step(i + 1);
     const bool wanted = a.every > 0 ? i % static_cast<size_t>(a.every) == 0 || (a.frame && i == last) : i == last;
     if (!wanted) continue;
-    const auto labels = reader.labels(i);
+    auto labels = reader.labels(i);
+    if (labels) labels = upright.labels(*labels, camera_depth.camera);
     handtrack::view::FrameView view;
     view.depth = &depth;
     const auto hands = handtrack::view::tracked_hands(tracker, output);
@@ -160,12 +195,13 @@ int run_sequence(const Args& a) {
     view.labels = labels ? &*labels : nullptr;
     view.labels_caption = "labels (sequence)";
     for (int h = 0; h < reader.hand_count(); ++h) {  // every ground-truth hand annotated in this frame
-      const handtrack::Fingertips tips = reader.fingertips(i, h);
+      const handtrack::Fingertips tips = upright.tips(reader.fingertips(i, h));
       if (std::any_of(tips.begin(), tips.end(), [](const auto& t) { return t.has_value(); })) {
         view.truth_tips.push_back(tips);
       }
     }
-    view.name = fs::path(a.seq).filename().string() + " frame " + std::to_string(reader.frame_number(i));
+    view.name =
+        fs::path(a.seq).filename().string() + " frame " + std::to_string(reader.frame_number(i)) + upright.caption();
     const fs::path file = a.every > 0 ? numbered(a.out, reader.frame_number(i)) : fs::path(a.out);
     handtrack::write_png_rgb(file, handtrack::view::render_frame(view, render_options(a)));
     ++written;
@@ -208,7 +244,9 @@ int run_single(const Args& a) {
   if (a.every > 0) throw UsageError("--every needs --seq");
   const handtrack::Gray16Image raw = handtrack::read_png_gray16(a.depth);
   const handtrack::CameraIntrinsics camera = single_frame_camera(a, raw.width, raw.height);
-  const handtrack::DepthImage depth = handtrack::DepthImage::from_raw(camera, raw.pixels);
+  Upright upright{*handtrack::parse_camera_roll(a.camera_roll), {}};
+  const handtrack::DepthImage camera_depth = handtrack::DepthImage::from_raw(camera, raw.pixels);
+  const handtrack::DepthImage& depth = upright.frame(camera_depth);
   std::optional<handtrack::Gray8Image> labels;
   if (!a.labels.empty()) {
     labels = handtrack::read_png_gray8(a.labels);
@@ -217,6 +255,7 @@ int run_single(const Args& a) {
                                std::to_string(labels->height) + ", depth is " + std::to_string(raw.width) + "x" +
                                std::to_string(raw.height));
     }
+    labels = upright.labels(*labels, camera);
   }
   // One frame: the tracker's (re)start path, the open hand placed at the segmented hand.
   handtrack::HandsTracker tracker(tracker_config(a));
@@ -228,7 +267,7 @@ int run_single(const Args& a) {
   view.hands = handtrack::view::hand_views(hands);
   view.labels = labels ? &*labels : nullptr;
   view.labels_caption = "labels " + fs::path(a.labels).filename().string();
-  view.name = fs::path(a.depth).filename().string();
+  view.name = fs::path(a.depth).filename().string() + upright.caption();
   handtrack::write_png_rgb(a.out, handtrack::view::render_frame(view, render_options(a)));
   return 0;
 }
@@ -280,6 +319,7 @@ int main(int argc, char** argv) {
                  "handtrackd's tracker.energy.slant_front")
       ->check(CLI::Range(1.0, 10.0));
   handtrack::tools::add_arrangement_option(app, a.arrangement);
+  handtrack::tools::add_camera_roll_option(app, a.camera_roll, " and drawn so");
   handtrack::tools::add_hand_option(app, a.hand);
   handtrack::tools::add_forest_option(app, a.forest);
   app.add_flag("--crop", a.crop, "Zoom all panels onto the segmented hand");

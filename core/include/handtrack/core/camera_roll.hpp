@@ -51,8 +51,9 @@ void turn_upright(const std::vector<T>& pixels, const CameraIntrinsics& camera, 
                   std::vector<T>* upright);
 void turn_upright(const DepthImage& image, CameraRoll roll, DepthImage* upright);
 
-// p_camera = R_z(phi) p_upright, exactly.
+// p_camera = R_z(phi) p_upright and p_upright = R_z(-phi) p_camera, exactly.
 Eigen::Vector3d turn_to_camera(CameraRoll roll, const Eigen::Vector3d& upright_p);
+Eigen::Vector3d turn_to_upright(CameraRoll roll, const Eigen::Vector3d& camera_p);
 
 // A pose tracked in the upright image, in the camera's own frame: joints, fingertips, palm centre
 // and normal, and the wrist position and global rotation of its parameters.

@@ -1,7 +1,9 @@
 #pragma once
 // The tracker options that handtrack-eval and handtrack-view share, spelt and checked as
 // handtrackd's configuration names their values (README, "Configuration"): the hand fitted, where
-// the camera looks from, and the part forest of late fusion.
+// the camera looks from, how it is turned, and the part forest of late fusion.
+
+#include "handtrack/core/camera_roll.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -26,6 +28,17 @@ inline CLI::Option* add_arrangement_option(CLI::App& app, std::string& arrangeme
                   "a hand, and which hand on which side of the image, auto handedness expects where the depth "
                   "leaves it open (handtrackd's tracker.arrangement)")
       ->check(CLI::IsMember({"facing", "head-mounted"}));
+}
+
+// --camera-roll: camera.roll (0, 90, 180, 270, or -90, -180 degrees); `degrees` keeps its value
+// unless given, and parse_camera_roll() takes any value it lets through.
+inline CLI::Option* add_camera_roll_option(CLI::App& app, std::string& degrees, const std::string& what) {
+  return app
+      .add_option("--camera-roll", degrees,
+                  "degrees the camera is turned about its optical axis, as handtrack-synth's --roll: 0 (default), "
+                  "90, 180 (upside down) or 270 (-90); each frame is tracked turned upright" + what +
+                      " (handtrackd's camera.roll; docs/TRACKER.md, \"A camera mounted turned\")")
+      ->check([](const std::string& v) { return parse_camera_roll(v) ? "" : "one of 0, 90, 180, 270 (or -90, -180)"; });
 }
 
 // --forest: tracker.forest_model; `forest` stays empty unless given (then the shipped one).
