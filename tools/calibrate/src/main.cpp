@@ -2,10 +2,12 @@
 // with the default hand model, then searches the user's hand scale (Sec. 6, hand_calibration.hpp)
 // and writes it as a hand profile for handtrackd (tracker.hand_profile) and handtrack-eval
 // (--hand-profile).
+#include "handtrack/core/camera_roll.hpp"
 #include "handtrack/core/hand_calibration.hpp"
 #include "handtrack/core/sequence.hpp"
 #include "handtrack/core/tracker.hpp"
 #include "handtrack/common/cli.hpp"
+#include "handtrack/tools/tracker_options.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -32,15 +34,23 @@ int main(int argc, char** argv) {
   app.add_option("--frames", keep.max_frames, "frames to calibrate on")->check(CLI::Range(1, 100));
   app.add_option("--stride", keep.stride, "at least this many frames between two calibration frames")
       ->check(CLI::Range(1, 10000));
+  std::string camera_roll = "0";
+  tools::add_camera_roll_option(app, camera_roll, " (a sequence recorded by handtrackd with camera.roll set)");
   if (const auto exit_code = parse_command_line(app, argc, argv, kProgram, 1)) return *exit_code;
+  const CameraRoll roll = *parse_camera_roll(camera_roll);  // one of the values the option's check let through
 
   try {
     const SequenceReader reader(sequence);
     const TrackerConfig config = calibration_tracker_config();
     Tracker tracker(config);
     CalibrationSet set(keep, config.input);
+    DepthImage upright;
     for (size_t i = 0; i < reader.frame_count() && !set.full(); ++i) {
-      const auto depth = reader.depth(i);
+      DepthImage depth = reader.depth(i);
+      if (roll != CameraRoll::k0) {
+        turn_upright(depth, roll, &upright);
+        std::swap(depth, upright);
+      }
       const auto tracked = tracker.track(depth);
       set.offer(depth, tracked, tracker.pose_tracker().hint());
     }
