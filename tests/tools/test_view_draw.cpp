@@ -9,11 +9,13 @@
 #include <png.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <limits>
 #include <set>
+#include <string>
 #include <tuple>
 
 namespace handtrack::draw {
@@ -214,6 +216,38 @@ TEST(Font, MetricsAndUnknownCharacters) {
   a.text(0, 0, "g", kInk);
   b.text(0, 0, "9", kInk);
   EXPECT_NE(inked(a), inked(b));
+}
+
+// A caption wider than its panel (handtrack-view's model caption on a 240-pixel portrait panel) is
+// broken at spaces into lines that fit, every word kept; one that fits, and its own line breaks,
+// stay as they are; a word wider than the panel is cut.
+TEST(Font, WrapKeepsEveryLineWithinTheWidth) {
+  const std::string caption = "model: tracking, right hand  conf 0.69  E 0.323\ntip error 17.8 mm (x = truth)";
+  for (const int width : {238, 120, 60}) {
+    for (const int scale : {1, 2}) {
+      const std::string wrapped = wrap_text(caption, width * scale, scale);
+      size_t start = 0;
+      std::string words;
+      while (start <= wrapped.size()) {
+        const size_t end = std::min(wrapped.find('\n', start), wrapped.size());
+        const std::string line = wrapped.substr(start, end - start);
+        EXPECT_LE(text_width(line, scale), width * scale) << "'" << line << "' at " << width << " px";
+        words += line + ' ';
+        start = end + 1;
+      }
+      std::string expected = caption;
+      std::replace(expected.begin(), expected.end(), '\n', ' ');
+      const auto squeeze = [](std::string t) {
+        t.erase(std::unique(t.begin(), t.end(), [](char a, char b) { return a == ' ' && b == ' '; }), t.end());
+        while (!t.empty() && t.back() == ' ') t.pop_back();
+        return t;
+      };
+      EXPECT_EQ(squeeze(words), squeeze(expected)) << width;
+    }
+  }
+  EXPECT_EQ(wrap_text(caption, 400), caption);
+  EXPECT_EQ(wrap_text("", 100), "");
+  EXPECT_EQ(wrap_text("abcdefghij", 4 * kGlyphAdvance), "abcd\nefgh\nij");
 }
 
 TEST(Colormap, DepthGrayNearIsBrightAndNoMeasurementIsBlack) {

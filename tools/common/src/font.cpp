@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <string>
 
 namespace handtrack::draw {
 namespace {
@@ -140,6 +141,32 @@ int text_height(std::string_view text, int scale) {
   if (text.empty()) return 0;
   const auto lines = 1 + std::count(text.begin(), text.end(), '\n');
   return (static_cast<int>(lines) * kLineAdvance - (kLineAdvance - kGlyphHeight)) * scale;
+}
+
+std::string wrap_text(std::string_view text, int max_width, int scale) {
+  scale = std::max(1, scale);
+  // Glyphs that fit: n glyphs take n * advance - (advance - width) pixels.
+  const auto fit = static_cast<size_t>(
+      std::max(1, (max_width + (kGlyphAdvance - kGlyphWidth) * scale) / (kGlyphAdvance * scale)));
+  std::string out;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t end = std::min(text.find('\n', start), text.size());
+    std::string_view line = text.substr(start, end - start);
+    while (line.size() > fit) {
+      const size_t space = line.rfind(' ', fit);
+      const size_t cut = space == std::string_view::npos || space == 0 ? fit : space;
+      out.append(line.substr(0, cut));
+      out.push_back('\n');
+      line.remove_prefix(cut);
+      while (!line.empty() && line.front() == ' ') line.remove_prefix(1);
+    }
+    out.append(line);
+    if (end == text.size()) break;
+    out.push_back('\n');
+    start = end + 1;
+  }
+  return out;
 }
 
 int Canvas::text(int x, int y, std::string_view text, Rgb colour, int scale) {

@@ -287,7 +287,10 @@ RgbImage render_frame(const FrameView& f, const RenderOptions& options) {
 
   const int scale = caption_scale(view.width);
   int caption_px = 0;
-  for (const auto& p : panels) caption_px = std::max(caption_px, draw::text_height(p.caption, scale));
+  for (auto& p : panels) {
+    p.caption = draw::wrap_text(p.caption, view.width - 2, scale);  // within its panel (narrow ones too)
+    caption_px = std::max(caption_px, draw::text_height(p.caption, scale));
+  }
   caption_px += 8;
   const int n = static_cast<int>(panels.size());
   Canvas out(n * view.width + (n + 1) * kPanelGapPx, caption_px + view.height + kPanelGapPx, kFrameBackground);

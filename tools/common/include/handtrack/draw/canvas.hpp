@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <string_view>
 
 namespace handtrack::draw {
@@ -91,5 +92,8 @@ inline constexpr int kLineAdvance = 9;
 // spacing below the last line).
 int text_width(std::string_view text, int scale = 1);
 int text_height(std::string_view text, int scale = 1);
+// `text` with its lines broken so that none is wider than `max_width` pixels at `scale`: at the
+// last space that fits (the space dropped), or mid-word where a word alone is too wide.
+std::string wrap_text(std::string_view text, int max_width, int scale = 1);
 
 }  // namespace handtrack::draw
