@@ -76,6 +76,12 @@ void turn_upright(const DepthImage& image, CameraRoll roll, DepthImage* upright)
   upright->mirrored = image.mirrored;
 }
 
+const DepthImage& upright_frame(const DepthImage& image, CameraRoll roll, DepthImage* scratch) {
+  if (roll == CameraRoll::k0) return image;
+  turn_upright(image, roll, scratch);
+  return *scratch;
+}
+
 Eigen::Vector3d turn_to_camera(CameraRoll roll, const Eigen::Vector3d& p) {
   switch (roll) {
     case CameraRoll::k0: return p;
@@ -87,7 +93,7 @@ Eigen::Vector3d turn_to_camera(CameraRoll roll, const Eigen::Vector3d& p) {
 }
 
 Eigen::Vector3d turn_to_upright(CameraRoll roll, const Eigen::Vector3d& p) {
-  return turn_to_camera(static_cast<CameraRoll>((4 - static_cast<int>(roll)) % 4), p);
+  return turn_to_camera(inverse(roll), p);
 }
 
 void turn_to_camera(CameraRoll roll, TrackerOutput* output) {
@@ -98,7 +104,7 @@ void turn_to_camera(CameraRoll roll, TrackerOutput* output) {
   output->palm_normal = turn_to_camera(roll, output->palm_normal);
   // The parameters: R_z(phi) for a right hand, R_z(-phi) in a left hand's mirrored image.
   const CameraRoll params_roll = output->handedness == Handedness::kLeft
-                                     ? static_cast<CameraRoll>((4 - static_cast<int>(roll)) % 4)
+                                     ? inverse(roll)
                                      : roll;
   PoseParams& params = output->params;
   const Eigen::Vector3d wrist = params.segment<3>(kTranslationParam);

@@ -87,4 +87,6 @@ std::optional<CameraRoll> camera_roll_from_degrees(int degrees) {
 
 int degrees(CameraRoll roll) { return 90 * static_cast<int>(roll); }
 
+CameraRoll inverse(CameraRoll roll) { return static_cast<CameraRoll>((4 - static_cast<int>(roll)) % 4); }
+
 }  // namespace handtrack

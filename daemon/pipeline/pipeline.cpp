@@ -292,7 +292,7 @@ bool Pipeline::start(std::string* why) {
   }
   const std::optional<CameraRoll> roll = camera_roll_from_degrees(m.config.camera_roll_deg);
   if (!roll) {
-    *why = fmt::format("camera.roll = {}: allowed: 0, 90, 180, 270 (or -90, -180)", m.config.camera_roll_deg);
+    *why = fmt::format("camera.roll = {}: allowed: {}", m.config.camera_roll_deg, kCameraRollValues);
     return false;
   }
   // The source starts after the forest is loaded: a recording plays in real time from its start.

@@ -477,7 +477,7 @@ void validate(const DaemonConfig& config, const std::string& origin) {
         f.ref);
   }
   if (!camera_roll_from_degrees(c.camera_roll_deg)) {
-    throw_config_error(origin, fmt::format("camera.roll = {}: allowed: 0, 90, 180, 270 (or -90, -180)", c.camera_roll_deg));
+    throw_config_error(origin, fmt::format("camera.roll = {}: allowed: {}", c.camera_roll_deg, kCameraRollValues));
   }
   if (c.shm_name.find('/') != std::string::npos) {
     throw_config_error(origin, fmt::format("daemon.shm_name = {}: allowed: a name without '/'", toml_quote(c.shm_name)));

@@ -46,11 +46,8 @@ int main(int argc, char** argv) {
     CalibrationSet set(keep, config.input);
     DepthImage upright;
     for (size_t i = 0; i < reader.frame_count() && !set.full(); ++i) {
-      DepthImage depth = reader.depth(i);
-      if (roll != CameraRoll::k0) {
-        turn_upright(depth, roll, &upright);
-        std::swap(depth, upright);
-      }
+      const DepthImage camera_depth = reader.depth(i);
+      const DepthImage& depth = upright_frame(camera_depth, roll, &upright);
       const auto tracked = tracker.track(depth);
       set.offer(depth, tracked, tracker.pose_tracker().hint());
     }

@@ -173,12 +173,7 @@ struct FrameLoop {
   // One frame: turned upright (--camera-roll; into *turned), tracked, its hands turned back into
   // the camera's frame, where the truth is.
   HandsOutput track(HandsTracker& tracker, const DepthImage& camera_depth, DepthImage* turned) const {
-    const DepthImage* depth = &camera_depth;
-    if (roll != CameraRoll::k0) {
-      turn_upright(camera_depth, roll, turned);
-      depth = turned;
-    }
-    HandsOutput out = tracker.track(*depth, labeller);
+    HandsOutput out = tracker.track(upright_frame(camera_depth, roll, turned), labeller);
     turn_to_camera(roll, &out);
     return out;
   }

@@ -68,9 +68,7 @@ struct Upright {
   handtrack::DepthImage depth;
 
   const handtrack::DepthImage& frame(const handtrack::DepthImage& camera_depth) {
-    if (roll == handtrack::CameraRoll::k0) return camera_depth;
-    handtrack::turn_upright(camera_depth, roll, &depth);
-    return depth;
+    return handtrack::upright_frame(camera_depth, roll, &depth);
   }
   [[nodiscard]] handtrack::Gray8Image labels(const handtrack::Gray8Image& camera_labels,
                                             const handtrack::CameraIntrinsics& camera) const {

@@ -39,6 +39,10 @@ enum class CameraRoll : uint8_t { k0, k90, k180, k270 };
 std::optional<CameraRoll> parse_camera_roll(const std::string& degrees);
 std::optional<CameraRoll> camera_roll_from_degrees(int degrees);
 int degrees(CameraRoll roll);  // 0, 90, 180, 270
+// What the two functions above take, for messages.
+inline constexpr const char* kCameraRollValues = "0, 90, 180, 270 (or -90, -180)";
+// The turn back: R_z(-phi).
+CameraRoll inverse(CameraRoll roll);
 
 // The camera's intrinsics as an upright camera has them.
 CameraIntrinsics upright_camera(const CameraIntrinsics& camera, CameraRoll roll);
@@ -50,6 +54,9 @@ template <typename T>
 void turn_upright(const std::vector<T>& pixels, const CameraIntrinsics& camera, CameraRoll roll,
                   std::vector<T>* upright);
 void turn_upright(const DepthImage& image, CameraRoll roll, DepthImage* upright);
+// The frame as the tracker sees it: `image` itself when the camera is upright, else `image` turned
+// upright into *scratch.
+const DepthImage& upright_frame(const DepthImage& image, CameraRoll roll, DepthImage* scratch);
 
 // p_camera = R_z(phi) p_upright and p_upright = R_z(-phi) p_camera, exactly.
 Eigen::Vector3d turn_to_camera(CameraRoll roll, const Eigen::Vector3d& upright_p);

@@ -38,7 +38,9 @@ inline CLI::Option* add_camera_roll_option(CLI::App& app, std::string& degrees, 
                   "degrees the camera is turned about its optical axis, as handtrack-synth's --roll: 0 (default), "
                   "90, 180 (upside down) or 270 (-90); each frame is tracked turned upright" + what +
                       " (handtrackd's camera.roll; docs/TRACKER.md, \"A camera mounted turned\")")
-      ->check([](const std::string& v) { return parse_camera_roll(v) ? "" : "one of 0, 90, 180, 270 (or -90, -180)"; });
+      ->check([](const std::string& v) {
+        return parse_camera_roll(v) ? std::string() : std::string("one of ") + kCameraRollValues;
+      });
 }
 
 // --forest: tracker.forest_model; `forest` stays empty unless given (then the shipped one).
