@@ -372,11 +372,13 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
       // The torso as a capsule of radius 220 mm (rounded: no plane for the tracker's desk
       // detection) whose top, seen in the lower half of the image, is about 430-600 mm away; neck
       // and a head (radius 65-85 mm, about 485-560 mm away) above it: inside the tracker's 150-600
-      // mm working volume, just behind the hand and touching its forearm. The body's place and the
-      // head's size vary with the seed (its own stream: the subject and noise are as with the other
-      // backgrounds).
+      // mm working volume, just behind the hand and touching its forearm; 60 mm farther in the
+      // views whose fingers curl toward it (views.hpp near_body_behind_mm). The body's place and
+      // the head's size vary with the seed (its own stream: the subject and noise are as with the
+      // other backgrounds).
       Rng rng = Rng::stream(s.options.seed, kBodyStream, 0);
-      const Vector3d at(rng.uniform(-60.0, 60.0), rng.uniform(-30.0, 30.0), rng.uniform(-30.0, 30.0));
+      Vector3d at(rng.uniform(-60.0, 60.0), rng.uniform(-30.0, 30.0), rng.uniform(-30.0, 30.0));
+      at.z() += near_body_behind_mm(arrangement);
       const double head = rng.uniform(65.0, 85.0);
       background_solids.push_back(
           ConeSphere{at + Vector3d(30, 330, 640), at + Vector3d(30, 900, 640), 220.0, 220.0, kBackground});

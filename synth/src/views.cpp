@@ -20,18 +20,19 @@ struct Arrangement {
   double turn_deg;   // about the hand's finger axis: 0 palm, 180 back, 90 thumb side toward the camera
   double tip_deg;    // about the camera x axis: + fingers toward the camera, - away
   double palm_depth_mm;  // 0: where the motion puts it
+  double near_body_behind_mm;  // Background::kNearBody this much farther than in the palm view
 };
 
 // clang-format off
 constexpr std::array<Arrangement, kViews.size()> kArrangements = {{
-    {View::kPalm, "palm", "desk camera facing the user, the palm toward it (the Dexter motions)", 0, 0, 0},
-    {View::kBack, "back", "desk camera, the back of the hand toward it (pointing at the screen)", 180, 0, 0},
-    {View::kSide, "side", "desk camera, the thumb side toward it", 90, 0, 0},
-    {View::kFingersToward, "fingers-toward", "the fingers tipped 50 deg toward the camera", 0, 50, 0},
-    {View::kFingersAway, "fingers-away", "the fingers tipped 50 deg away from the camera", 0, -50, 0},
+    {View::kPalm, "palm", "desk camera facing the user, the palm toward it (the Dexter motions)", 0, 0, 0, 0},
+    {View::kBack, "back", "desk camera, the back of the hand toward it (pointing at the screen)", 180, 0, 0, 60},
+    {View::kSide, "side", "desk camera, the thumb side toward it", 90, 0, 0, 60},
+    {View::kFingersToward, "fingers-toward", "the fingers tipped 50 deg toward the camera", 0, 50, 0, 0},
+    {View::kFingersAway, "fingers-away", "the fingers tipped 50 deg away from the camera", 0, -50, 0, 60},
     {View::kHeadMounted, "head-mounted",
      "egocentric camera behind the hand: back toward it, fingers 65 deg away, forearm from the image bottom",
-     180, -65, 330},
+     180, -65, 330, 0},
 }};
 // clang-format on
 
@@ -42,6 +43,8 @@ const Arrangement& arrangement(View view) { return kArrangements[static_cast<siz
 std::string_view view_name(View view) { return arrangement(view).name; }
 
 std::string_view view_description(View view) { return arrangement(view).description; }
+
+double near_body_behind_mm(View view) { return arrangement(view).near_body_behind_mm; }
 
 std::optional<View> parse_view(std::string_view name) {
   for (const auto& a : kArrangements) {
