@@ -372,7 +372,7 @@ SyntheticCamera::SyntheticCamera(SynthOptions options) {
       // The torso as a capsule of radius 220 mm (rounded: no plane for the tracker's desk
       // detection) whose top, seen in the lower half of the image, is about 430-600 mm away; neck
       // and a head (radius 65-85 mm, about 485-560 mm away) above it: inside the tracker's 150-600
-      // mm working volume, just behind the hand and touching its forearm; 60 mm farther in the
+      // mm working volume, just behind the hand and touching its forearm; 90 mm farther in the
       // views whose fingers curl toward it (views.hpp near_body_behind_mm). The body's place and
       // the head's size vary with the seed (its own stream: the subject and noise are as with the
       // other backgrounds).

@@ -26,10 +26,10 @@ struct Arrangement {
 // clang-format off
 constexpr std::array<Arrangement, kViews.size()> kArrangements = {{
     {View::kPalm, "palm", "desk camera facing the user, the palm toward it (the Dexter motions)", 0, 0, 0, 0},
-    {View::kBack, "back", "desk camera, the back of the hand toward it (pointing at the screen)", 180, 0, 0, 60},
-    {View::kSide, "side", "desk camera, the thumb side toward it", 90, 0, 0, 60},
+    {View::kBack, "back", "desk camera, the back of the hand toward it (pointing at the screen)", 180, 0, 0, 90},
+    {View::kSide, "side", "desk camera, the thumb side toward it", 90, 0, 0, 90},
     {View::kFingersToward, "fingers-toward", "the fingers tipped 50 deg toward the camera", 0, 50, 0, 0},
-    {View::kFingersAway, "fingers-away", "the fingers tipped 50 deg away from the camera", 0, -50, 0, 60},
+    {View::kFingersAway, "fingers-away", "the fingers tipped 50 deg away from the camera", 0, -50, 0, 90},
     {View::kHeadMounted, "head-mounted",
      "egocentric camera behind the hand: back toward it, fingers 65 deg away, forearm from the image bottom",
      180, -65, 330, 0},

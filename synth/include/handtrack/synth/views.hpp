@@ -38,9 +38,10 @@ std::optional<View> parse_view(std::string_view name);
 std::string_view view_description(View view);  // one line for --list-views
 
 // How much farther a user close to the camera (Background::kNearBody) sits in `view` than in the
-// palm view: 60 mm where the fingers curl toward the body (the back and side views, fingers tipped
-// away). As near as in the palm view they came within 5 mm of the head or went into it, which
-// joins hand and body into one surface for a tracker; 0 where the fingers curl toward the camera.
+// palm view: 90 mm where the fingers curl or tip toward the body (the back and side views, fingers
+// tipped away). As near as in the palm view they went up to 46 mm into the head (subjects 1-7),
+// and touching, hand and body are one surface to a tracker; 0 where the fingers curl toward the
+// camera.
 double near_body_behind_mm(View view);
 
 // The motion's pose seen in `view`: turned about the palm centre and, where the arrangement fixes
